@@ -1,0 +1,40 @@
+#pragma once
+// The rfem program's commands. Each returns the process exit code; bad input throws CaseError
+// (exit 2), solver failures throw std::runtime_error (exit 1).
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cases/case_file.hpp"
+
+namespace rfem::app {
+
+/// Options every command shares.
+struct Common {
+  std::string case_path;
+  std::vector<std::string> overrides;  ///< --set key.path=value
+  int n = 0;                           ///< --n (0: the case's discretisation)
+  bool json = false;
+  int threads = 0;
+};
+
+struct ModesOptions {
+  int count = 6;
+  double rate = 0.0;  ///< --rate: steady rate of joint `joint` [rad/s or m/s]
+  int joint = 1;      ///< 1-based
+  bool rate_given = false;
+};
+
+int run_static(const Common& c);
+int run_modes(const Common& c, const ModesOptions& o);
+int run_refine(const Common& c, const std::vector<int>& ns, const std::string& quantity, const ModesOptions& o);
+
+/// Joint values and rates of the case, with --rate applied.
+void joint_state(const Case& cs, const ModesOptions& o, VecX& qb, VecX& vb);
+/// Evaluates a named scalar quantity (see README: "tip:uz", "mode:1", "bending-y:2", …) at n rfes.
+double evaluate_quantity(const Case& cs, int n, const std::string& quantity, const ModesOptions& o);
+
+void print_json(const nlohmann::json& j);
+
+}  // namespace rfem::app

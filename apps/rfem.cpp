@@ -1,0 +1,84 @@
+// rfem: the command-line program. See README.md for every command and its output.
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+#include <omp.h>
+
+#include <Eigen/Core>
+#include <sstream>
+
+#include "apps/commands.hpp"
+
+int main(int argc, char** argv) {
+  using namespace rfem::app;
+  CLI::App app{"rfem: dynamics of manipulators with flexible links by the Rigid Finite Element Method"};
+  app.set_version_flag("--version", std::string("rfem ") + RFEM_VERSION);
+  app.require_subcommand(1);
+  Common common;
+  app.add_option("--threads", common.threads, "OpenMP threads for assembly (default: all cores)")
+      ->check(CLI::PositiveNumber);
+  auto add_common = [&](CLI::App* sub) {
+    sub->add_option("case", common.case_path, "case file (TOML)")->required();
+    sub->add_option("--set", common.overrides, "override a case value: key.path=value (repeatable)");
+    sub->add_option("--n", common.n, "number of rfes, distributed over the segments by length")
+        ->check(CLI::PositiveNumber);
+    sub->add_flag("--json", common.json, "print results as JSON");
+  };
+  ModesOptions mo;
+  auto add_rate = [&](CLI::App* sub) {
+    sub->add_option("--rate", mo.rate, "steady rate of the chosen joint [rad/s]")->each([&](const std::string&) {
+      mo.rate_given = true;
+    });
+    sub->add_option("--joint", mo.joint, "joint (1-based) that --rate applies to")->check(CLI::PositiveNumber);
+  };
+
+  auto* st = app.add_subcommand("static", "static equilibrium under gravity and tip loads, joints held");
+  add_common(st);
+  auto* md = app.add_subcommand("modes", "natural frequencies and mode shapes of the flexible link, base held");
+  add_common(md);
+  md->add_option("--count", mo.count, "number of modes")->check(CLI::PositiveNumber);
+  add_rate(md);
+  auto* rf = app.add_subcommand("refine", "convergence table of a quantity over a series of n");
+  add_common(rf);
+  std::string ns_text = "5,10,20,40,80", quantity = "mode:1";
+  rf->add_option("--ns", ns_text, "comma-separated list of n (alias of --n for refine)");
+  rf->add_option("--quantity", quantity, "tip:ux|uy|uz|rx|ry|rz, mode:K, bending-y:K, bending-z:K, axial:K, torsion:K");
+  add_rate(rf);
+  // refine takes a list in --n: reroute it before parsing.
+  for (int i = 1; i + 1 < argc; ++i)
+    if (std::string(argv[i]) == "refine")
+      for (int k = i + 1; k + 1 < argc; ++k)
+        if (std::string(argv[k]) == "--n") argv[k] = const_cast<char*>("--ns");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  if (common.threads > 0) omp_set_num_threads(common.threads);
+  Eigen::setNbThreads(1);  // we parallelise ourselves
+  try {
+    if (st->parsed()) return run_static(common);
+    if (md->parsed()) return run_modes(common, mo);
+    if (rf->parsed()) {
+      std::vector<int> ns;
+      std::stringstream ss(ns_text);
+      for (std::string t; std::getline(ss, t, ',');) {
+        try {
+          ns.push_back(std::stoi(t));
+        } catch (...) {
+          throw rfem::CaseError("--n: '" + t + "' is not an integer");
+        }
+        if (ns.back() < 1) throw rfem::CaseError("--n: every n must be positive");
+      }
+      if (ns.size() < 2) throw rfem::CaseError("--n: refine needs at least two values");
+      return run_refine(common, ns, quantity, mo);
+    }
+  } catch (const rfem::CaseError& e) {
+    fmt::print(stderr, "rfem: error: {}\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "rfem: error: {}\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,47 @@
+#pragma once
+// Per-rfe kernels. World pose of rfe k: W_k = B0 C_k D_k(q_k) [2.5] with C_k = Trans(centre_k).
+// Kinetic energy T_k = ½ tr(Ẇ H Ẇᵀ) [3.6]; the Lagrange term of coordinate j is
+// ε_j = tr(∂W/∂q_j H Ẅᵀ) (FORMULATION.md §3), which gives M a + h in one pass without b-tensors.
+// Base rows are returned as 4×4 "moment" matrices that the caller contracts with Ξ_j
+// (core/kinematics.hpp): ε_bj = tr(Ξ_j Y), M_bj,bl = tr(Ξ_j G Ξ_lᵀ), gravity g e₃ᵀ Ξ_j s.
+#include "core/kinematics.hpp"
+#include "core/rotation.hpp"
+
+namespace rfem {
+
+/// Everything about one rfe at one configuration that several kernels share.
+struct RfePose {
+  DeformationTransform d;
+  Mat4 W;      ///< world pose
+  Mat3 R0;     ///< rotation of {r} in {0}
+  Mat34 Wdd;   ///< top rows of Ẅ
+};
+
+/// Pose, and Ẅ = B̈0 P + 2 Ḃ0 Ṗ + B0 P̈ with P = C D.
+void rfe_pose(const Rfe& rfe, const BaseKinematics& bk, const Vec6& q, const Vec6& v, const Vec6& a,
+              RfePose& out);
+
+/// Inertial force ε (= M a + h) on the rfe's own coordinates, and Y = W H Ẅᵀ for the base rows.
+void rfe_inertial_force(const Rfe& rfe, const RfePose& p, Vec6& eps, Mat4& Y);
+
+/// Gravity force ∂V_g/∂q_k (only the translations: the rfe's origin is its mass centre) and
+/// s = W H e₄ (mass × homogeneous position of the mass centre) for the base rows.
+void rfe_gravity_force(const Rfe& rfe, const RfePose& p, double g, Vec6& f, Vec4& s);
+
+/// Mass blocks: M_kk (6×6), border M_bk (m×6, row j = tr(Ξ_j W H ∂W/∂q_lᵀ)), G = W H Wᵀ.
+void rfe_mass_blocks(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, Mat6& Mkk,
+                     MatX& border, Mat4& G);
+
+/// Gravity stiffness border ∂²V_g/∂q_b,j∂q_k,l (the rfe's own block is zero) written into
+/// `border` (m×6), added.
+void rfe_gravity_border(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, double g,
+                        MatX& border);
+
+/// ∂ε_k/∂q_k at zero rfe velocity and acceleration: the centrifugal stiffness of a moving base
+/// (used by modal analysis about a steady rotation), symmetrised.
+Mat6 rfe_inertial_stiffness(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk);
+
+/// Kinetic energy ½ tr(Ẇ H Ẇᵀ) with Ẇ = Ḃ0 P + B0 Ṗ.
+double rfe_kinetic_energy(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, const Vec6& v);
+
+}  // namespace rfem

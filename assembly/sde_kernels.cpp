@@ -1,0 +1,78 @@
+#include "assembly/sde_kernels.hpp"
+
+namespace rfem {
+
+namespace {
+
+struct SdeGeometry {
+  Eigen::Matrix<double, 3, 12> J;  ///< ∂Δx/∂q
+  Vec3 dx;                         ///< Δx
+  DeformationTransform dl, dp;
+};
+
+void geometry(const Sde& e, const Vec3& cl, const Vec3& cr, const Vec6& ql, const Vec6& qp,
+              SdeGeometry& g) {
+  const bool has_left = e.left >= 0;
+  deformation_transform(has_left ? ql : Vec6::Zero().eval(), g.dl);
+  deformation_transform(qp, g.dp);
+  const Vec3 pl = cl + g.dl.D.topLeftCorner<3, 3>() * e.eta_left + g.dl.D.topRightCorner<3, 1>();
+  const Vec3 pr = cr + g.dp.D.topLeftCorner<3, 3>() * e.eta_right + g.dp.D.topRightCorner<3, 1>();
+  g.dx = pr - pl;
+  g.J.setZero();
+  g.J.block<3, 3>(0, 0) = -Mat3::Identity();
+  g.J.block<3, 3>(0, 6) = Mat3::Identity();
+  for (int a = 0; a < 3; ++a) {
+    g.J.col(3 + a) = -(g.dl.dR[a] * e.eta_left);
+    g.J.col(9 + a) = g.dp.dR[a] * e.eta_right;
+  }
+  if (!has_left) g.J.leftCols<6>().setZero();
+}
+
+}  // namespace
+
+void sde_forces(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const Vec6& ql,
+                const Vec6& vl, const Vec6& qp, const Vec6& vp, SdeResult& out) {
+  SdeGeometry g;
+  geometry(e, cl, cr, ql, qp, g);
+  const bool has_left = e.left >= 0;
+  const Vec3 dphi = qp.tail<3>() - (has_left ? ql.tail<3>() : Vec3::Zero().eval());
+  Vec12 qdot;
+  qdot << (has_left ? vl : Vec6::Zero().eval()), vp;
+  const Vec3 dx_dot = g.J * qdot;
+  const Vec3 dphi_dot = qdot.segment<3>(9) - qdot.segment<3>(3);
+  const Vec3 lam = e.c.cwiseProduct(g.dx + beta * dx_dot);       // spring + damper force
+  const Vec3 mu = e.k.cwiseProduct(dphi + beta * dphi_dot);       // spring + damper moment
+  out.f = g.J.transpose() * lam;
+  out.f.segment<3>(3) -= mu;
+  out.f.segment<3>(9) += mu;
+  if (!has_left) out.f.head<6>().setZero();
+  out.V = 0.5 * g.dx.dot(e.c.cwiseProduct(g.dx)) + 0.5 * dphi.dot(e.k.cwiseProduct(dphi));
+  out.P_d = beta * (dx_dot.dot(e.c.cwiseProduct(dx_dot)) + dphi_dot.dot(e.k.cwiseProduct(dphi_dot)));
+}
+
+void sde_matrix(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const Vec6& ql,
+                const Vec6& qp, double ck, double cd, Mat12& S) {
+  SdeGeometry g;
+  geometry(e, cl, cr, ql, qp, g);
+  Mat12 base = g.J.transpose() * e.c.asDiagonal() * g.J;  // Jᵀ c J
+  for (int a = 0; a < 3; ++a) {
+    base(3 + a, 3 + a) += e.k[a];
+    base(9 + a, 9 + a) += e.k[a];
+    base(3 + a, 9 + a) -= e.k[a];
+    base(9 + a, 3 + a) -= e.k[a];
+  }
+  if (e.left < 0) {
+    base.topRows<6>().setZero();
+    base.leftCols<6>().setZero();
+  }
+  S.noalias() += (ck + cd * beta) * base;
+  // Geometric term Σ_i λ_i ∂²Δx_i/∂φ∂φ, λ = c Δx (the spring force turning with the rfe).
+  const Vec3 lam = e.c.cwiseProduct(g.dx);
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) {
+      S(9 + a, 9 + b) += ck * lam.dot(g.dp.ddR[a][b] * e.eta_right);
+      if (e.left >= 0) S(3 + a, 3 + b) -= ck * lam.dot(g.dl.ddR[a][b] * e.eta_left);
+    }
+}
+
+}  // namespace rfem

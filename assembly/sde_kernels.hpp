@@ -1,0 +1,26 @@
+#pragma once
+// Per-sde kernel [3.12]–[3.17]. Attachment points in {r}: p = C D η = centre + x + R(φ) η.
+// Relative displacement Δx = p_right − p_left (sde axes = link axes), rotation difference
+// Δφ = φ_right − φ_left. V = ½ Δxᵀ diag(c) Δx + ½ Δφᵀ diag(k) Δφ; damping d = β c, β k.
+// Coordinates are the 12 of [rfe left; rfe right]; rfe_0 (left = −1) enters with zeros.
+#include "core/link.hpp"
+#include "core/rotation.hpp"
+
+namespace rfem {
+
+struct SdeResult {
+  Vec12 f;     ///< elastic + damping generalised force ∂V/∂q + ∂R/∂q̇
+  double V = 0.0;    ///< elastic energy [J]
+  double P_d = 0.0;  ///< dissipated power [W]
+};
+
+/// Forces, energy and dissipation of sde `e` (ql/vl ignored when e.left == −1).
+void sde_forces(const Sde& e, const Vec3& centre_left, const Vec3& centre_right, double beta,
+                const Vec6& ql, const Vec6& vl, const Vec6& qp, const Vec6& vp, SdeResult& out);
+
+/// Stiffness K = ∂²V/∂q² (with the geometric term of the rotated attachment points) and damping
+/// C = β (Jᵀ diag(c) J + rotational part): S += ck K + cd C.
+void sde_matrix(const Sde& e, const Vec3& centre_left, const Vec3& centre_right, double beta,
+                const Vec6& ql, const Vec6& qp, double ck, double cd, Mat12& S);
+
+}  // namespace rfem

@@ -1,0 +1,411 @@
+#include "cases/case_file.hpp"
+
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "core/rotation.hpp"
+
+namespace rfem {
+
+namespace {
+
+// Reads typed values from a toml table with the file, line and dotted key in every error.
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const toml::node* node, const std::string& key, const std::string& what) const {
+    std::ostringstream os;
+    os << file_;
+    if (node && node->source().begin.line > 0) os << ":" << node->source().begin.line;
+    else os << " (--set or missing)";
+    os << ": " << key << ": " << what;
+    throw CaseError(os.str());
+  }
+
+  void check_keys(const toml::table& t, const std::string& path, const std::set<std::string>& allowed) const {
+    for (const auto& [k, v] : t)
+      if (!allowed.count(std::string(k.str()))) {
+        std::string list;
+        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        fail(&v, join(path, std::string(k.str())), "unknown key (allowed: " + list + ")");
+      }
+  }
+
+  const toml::table& table(const toml::table& t, const std::string& path, const std::string& key) const {
+    const toml::node* n = t.get(key);
+    if (!n) fail(&t, join(path, key), "missing table");
+    if (!n->is_table()) fail(n, join(path, key), "must be a table");
+    return *n->as_table();
+  }
+
+  double number(const toml::table& t, const std::string& path, const std::string& key,
+                std::optional<double> dflt = std::nullopt) const {
+    const toml::node* n = t.get(key);
+    const std::string k = join(path, key);
+    if (!n) {
+      if (dflt) return *dflt;
+      fail(&t, k, "missing (a number is required)");
+    }
+    double v;
+    if (auto f = n->as_floating_point()) v = f->get();
+    else if (auto i = n->as_integer()) v = static_cast<double>(i->get());
+    else fail(n, k, std::string("must be a number, not ") + type_name(*n));
+    if (!std::isfinite(v)) fail(n, k, "must be finite (got " + std::to_string(v) + ")");
+    return v;
+  }
+
+  double positive(const toml::table& t, const std::string& path, const std::string& key,
+                  std::optional<double> dflt = std::nullopt) const {
+    const double v = number(t, path, key, dflt);
+    if (!(v > 0.0)) fail(t.get(key) ? t.get(key) : &t, join(path, key), "must be positive (got " + fmt(v) + ")");
+    return v;
+  }
+
+  double non_negative(const toml::table& t, const std::string& path, const std::string& key, double dflt) const {
+    const double v = number(t, path, key, dflt);
+    if (v < 0.0) fail(t.get(key), join(path, key), "must not be negative (got " + fmt(v) + ")");
+    return v;
+  }
+
+  long integer(const toml::table& t, const std::string& path, const std::string& key, long dflt, long min) const {
+    const toml::node* n = t.get(key);
+    if (!n) return dflt;
+    auto i = n->as_integer();
+    if (!i) fail(n, join(path, key), std::string("must be an integer, not ") + type_name(*n));
+    if (i->get() < min) fail(n, join(path, key), "must be at least " + std::to_string(min) + " (got " + std::to_string(i->get()) + ")");
+    return static_cast<long>(i->get());
+  }
+
+  std::string string(const toml::table& t, const std::string& path, const std::string& key,
+                     std::optional<std::string> dflt = std::nullopt) const {
+    const toml::node* n = t.get(key);
+    if (!n) {
+      if (dflt) return *dflt;
+      fail(&t, join(path, key), "missing (a string is required)");
+    }
+    auto s = n->as_string();
+    if (!s) fail(n, join(path, key), std::string("must be a string, not ") + type_name(*n));
+    return s->get();
+  }
+
+  Vec3 vec3(const toml::table& t, const std::string& path, const std::string& key, Vec3 dflt) const {
+    const toml::node* n = t.get(key);
+    if (!n) return dflt;
+    auto a = n->as_array();
+    if (!a || a->size() != 3) fail(n, join(path, key), "must be an array of three numbers");
+    Vec3 v;
+    for (int i = 0; i < 3; ++i) {
+      const toml::node& e = *a->get(i);
+      if (auto f = e.as_floating_point()) v[i] = f->get();
+      else if (auto x = e.as_integer()) v[i] = static_cast<double>(x->get());
+      else fail(&e, join(path, key), "must be an array of three numbers");
+      if (!std::isfinite(v[i])) fail(&e, join(path, key), "must be finite");
+    }
+    return v;
+  }
+
+  static std::string join(const std::string& a, const std::string& b) { return a.empty() ? b : a + "." + b; }
+  static std::string fmt(double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+  }
+  static const char* type_name(const toml::node& n) {
+    switch (n.type()) {
+      case toml::node_type::table: return "a table";
+      case toml::node_type::array: return "an array";
+      case toml::node_type::string: return "a string";
+      case toml::node_type::integer: return "an integer";
+      case toml::node_type::floating_point: return "a float";
+      case toml::node_type::boolean: return "a boolean";
+      default: return "a date/time";
+    }
+  }
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+};
+
+// "a.b.0.c=value": parse the value as TOML and put it at the path (creating tables as needed).
+void apply_override(toml::table& root, const std::string& file, const std::string& spec) {
+  const auto eq = spec.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw CaseError(file + ": --set " + spec + ": expected key.path=value");
+  const std::string path = spec.substr(0, eq), value = spec.substr(eq + 1);
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + value);
+  } catch (const toml::parse_error& e) {
+    // A bare word is taken as a string (e.g. --set joints.0.type=prismatic).
+    try {
+      parsed = toml::parse("v = \"" + value + "\"");
+    } catch (const toml::parse_error&) {
+      throw CaseError(file + ": --set " + path + ": cannot parse value '" + value + "'");
+    }
+  }
+  std::vector<std::string> keys;
+  std::stringstream ss(path);
+  for (std::string k; std::getline(ss, k, '.');) keys.push_back(k);
+  toml::node* cur = &root;
+  for (size_t i = 0; i < keys.size(); ++i) {
+    const bool last = i + 1 == keys.size();
+    const std::string& k = keys[i];
+    if (auto t = cur->as_table()) {
+      if (last) {
+        t->insert_or_assign(k, *parsed.get("v"));
+        return;
+      }
+      if (!t->get(k)) t->insert(k, toml::table{});
+      cur = t->get(k);
+    } else if (auto a = cur->as_array()) {
+      size_t idx = 0;
+      try {
+        idx = std::stoul(k);
+      } catch (...) {
+        throw CaseError(file + ": --set " + path + ": '" + k + "' must be an array index");
+      }
+      if (idx >= a->size()) throw CaseError(file + ": --set " + path + ": index " + k + " out of range");
+      if (last) {
+        a->replace(a->begin() + static_cast<long>(idx), *parsed.get("v"));
+        return;
+      }
+      cur = a->get(idx);
+    } else {
+      throw CaseError(file + ": --set " + path + ": '" + keys[i - 1] + "' is not a table or array");
+    }
+  }
+}
+
+Mat4 transform(const Reader& r, const toml::table& t, const std::string& path) {
+  r.check_keys(t, path, {"xyz", "rpy"});
+  return homogeneous(rot_rpy(r.vec3(t, path, "rpy", Vec3::Zero())), r.vec3(t, path, "xyz", Vec3::Zero()));
+}
+
+Material read_material(const Reader& r, const toml::table& t, const std::string& path, const std::string& name) {
+  r.check_keys(t, path, {"E", "G", "rho"});
+  Material m;
+  m.name = name;
+  m.E = r.positive(t, path, "E");
+  m.G = r.positive(t, path, "G");
+  m.rho = r.positive(t, path, "rho");
+  return m;
+}
+
+Section read_section(const Reader& r, const toml::table& t, const std::string& path, const std::string& name) {
+  if (t.get("box")) {
+    r.check_keys(t, path, {"box", "kappa_y", "kappa_z"});
+    const toml::table& b = r.table(t, path, "box");
+    const std::string bp = path + ".box";
+    r.check_keys(b, bp, {"outer", "inner"});
+    const double outer = r.positive(b, bp, "outer"), inner = r.non_negative(b, bp, "inner", 0.0);
+    if (inner >= outer) r.fail(b.get("inner"), bp + ".inner", "must be smaller than outer");
+    Section s = box_section(name, outer, inner);
+    s.kappa_y = r.positive(t, path, "kappa_y", s.kappa_y);
+    s.kappa_z = r.positive(t, path, "kappa_z", s.kappa_z);
+    return s;
+  }
+  r.check_keys(t, path, {"A", "Iy", "Iz", "J", "kappa_y", "kappa_z", "offset_y", "offset_z"});
+  Section s;
+  s.name = name;
+  s.A = r.positive(t, path, "A");
+  s.Iy = r.positive(t, path, "Iy");
+  s.Iz = r.positive(t, path, "Iz");
+  s.J = r.positive(t, path, "J");
+  s.kappa_y = r.positive(t, path, "kappa_y", 5.0 / 6.0);
+  s.kappa_z = r.positive(t, path, "kappa_z", 5.0 / 6.0);
+  s.offset = Vec3(0.0, r.number(t, path, "offset_y", 0.0), r.number(t, path, "offset_z", 0.0));
+  return s;
+}
+
+template <class T>
+std::map<std::string, T> read_named(const Reader& r, const toml::table& root, const std::string& key,
+                                    T (*read)(const Reader&, const toml::table&, const std::string&, const std::string&)) {
+  std::map<std::string, T> out;
+  const toml::node* n = root.get(key);
+  if (!n) return out;
+  if (!n->is_table()) r.fail(n, key, "must be a table of named entries");
+  for (const auto& [k, v] : *n->as_table()) {
+    const std::string path = key + "." + std::string(k.str());
+    if (!v.is_table()) r.fail(&v, path, "must be a table");
+    out.emplace(std::string(k.str()), read(r, *v.as_table(), path, std::string(k.str())));
+  }
+  return out;
+}
+
+Mat4 read_body(const Reader& r, const toml::table& t, const std::string& path,
+               const std::map<std::string, Material>& mats, const std::map<std::string, Section>& secs) {
+  if (t.get("section")) {
+    // Uniform prismatic link along its frame's x axis from the origin.
+    r.check_keys(t, path, {"section", "material", "length"});
+    const std::string sn = r.string(t, path, "section"), mn = r.string(t, path, "material");
+    if (!secs.count(sn)) r.fail(t.get("section"), path + ".section", "no section named '" + sn + "'");
+    if (!mats.count(mn)) r.fail(t.get("material"), path + ".material", "no material named '" + mn + "'");
+    const double L = r.positive(t, path, "length");
+    const Section& s = secs.at(sn);
+    const double rho = mats.at(mn).rho, mass = rho * s.A * L;
+    Mat3 I = Mat3::Zero();  // about the mass centre; Ixx from the polar second moment
+    I(0, 0) = rho * L * (s.Iy + s.Iz);
+    I(1, 1) = mass * L * L / 12.0 + rho * L * s.Iy;
+    I(2, 2) = mass * L * L / 12.0 + rho * L * s.Iz;
+    return pseudo_inertia(mass, Vec3(0.5 * L, 0, 0), I);
+  }
+  r.check_keys(t, path, {"mass", "com", "inertia"});
+  const double mass = r.non_negative(t, path, "mass", 0.0);
+  const Vec3 com = r.vec3(t, path, "com", Vec3::Zero());
+  Mat3 I = Mat3::Zero();
+  if (const toml::node* n = t.get("inertia")) {
+    auto a = n->as_array();
+    if (!a || a->size() != 6) r.fail(n, path + ".inertia", "must be [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]");
+    double v[6];
+    for (int i = 0; i < 6; ++i) {
+      const toml::node& e = *a->get(i);
+      if (auto f = e.as_floating_point()) v[i] = f->get();
+      else if (auto x = e.as_integer()) v[i] = static_cast<double>(x->get());
+      else r.fail(&e, path + ".inertia", "must be six numbers");
+      if (!std::isfinite(v[i])) r.fail(&e, path + ".inertia", "must be finite");
+    }
+    I << v[0], v[3], v[4], v[3], v[1], v[5], v[4], v[5], v[2];
+    if (I.selfadjointView<Eigen::Upper>().eigenvalues().minCoeff() < 0.0 || v[0] + v[1] < v[2] ||
+        v[1] + v[2] < v[0] || v[0] + v[2] < v[1])
+      r.fail(n, path + ".inertia", "is not a physical inertia tensor");
+  }
+  return pseudo_inertia(mass, com, I);
+}
+
+}  // namespace
+
+Case read_case(const std::string& path, const std::vector<std::string>& overrides) {
+  Case c;
+  c.path = path;
+  std::ifstream in(path);
+  if (!in) throw CaseError(path + ": cannot open case file");
+  std::stringstream buf;
+  buf << in.rdbuf();
+  c.text = buf.str();
+  toml::table root;
+  try {
+    root = toml::parse(c.text, path);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream os;
+    os << path << ":" << e.source().begin.line << ": syntax error: " << e.description();
+    throw CaseError(os.str());
+  }
+  for (const auto& o : overrides) apply_override(root, path, o);
+  const Reader r(path);
+  r.check_keys(root, "", {"case", "materials", "sections", "link", "joints", "gravity", "loads"});
+
+  if (const toml::node* n = root.get("case")) {
+    if (!n->is_table()) r.fail(n, "case", "must be a table");
+    r.check_keys(*n->as_table(), "case", {"name", "description"});
+    c.name = r.string(*n->as_table(), "case", "name", std::string());
+    c.description = r.string(*n->as_table(), "case", "description", std::string());
+  }
+  const auto mats = read_named<Material>(r, root, "materials", read_material);
+  const auto secs = read_named<Section>(r, root, "sections", read_section);
+
+  if (const toml::node* ln = root.get("link")) {
+    if (!ln->is_table()) r.fail(ln, "link", "must be a table");
+    const toml::table& lt = *ln->as_table();
+    r.check_keys(lt, "link", {"n", "damping_beta", "mount", "segments"});
+    c.has_link = true;
+    c.n = static_cast<int>(r.integer(lt, "link", "n", 0, 1));
+    c.link.damping_beta = r.non_negative(lt, "link", "damping_beta", 0.0);
+    if (const toml::node* mn = lt.get("mount")) {
+      if (!mn->is_table()) r.fail(mn, "link.mount", "must be a table {xyz, rpy}");
+      c.mount = transform(r, *mn->as_table(), "link.mount");
+    }
+    const toml::node* sn = lt.get("segments");
+    if (!sn) r.fail(&lt, "link.segments", "missing: a link needs at least one segment");
+    auto arr = sn->as_array();
+    if (!arr || arr->empty() || !arr->is_array_of_tables())
+      r.fail(sn, "link.segments", "must be a non-empty array of tables ([[link.segments]])");
+    for (size_t i = 0; i < arr->size(); ++i) {
+      const toml::table& st = *arr->get(i)->as_table();
+      const std::string p = "link.segments." + std::to_string(i);
+      r.check_keys(st, p, {"length", "material", "section", "parts"});
+      Segment s;
+      s.length = r.positive(st, p, "length");
+      const std::string mn = r.string(st, p, "material"), sc = r.string(st, p, "section");
+      if (!mats.count(mn)) r.fail(st.get("material"), p + ".material", "no material named '" + mn + "'");
+      if (!secs.count(sc)) r.fail(st.get("section"), p + ".section", "no section named '" + sc + "'");
+      s.material = mats.at(mn);
+      s.section = secs.at(sc);
+      if (!st.get("parts") && c.n == 0) r.fail(&st, p + ".parts", "missing (give parts per segment or link.n)");
+      s.parts = static_cast<int>(r.integer(st, p, "parts", 1, 1));
+      c.link.segments.push_back(s);
+    }
+    if (c.n > 0 && c.n < static_cast<int>(c.link.segments.size()))
+      r.fail(lt.get("n"), "link.n", "n = " + std::to_string(c.n) + " cannot cover " +
+                                        std::to_string(c.link.segments.size()) + " segments (one part each at least)");
+  }
+
+  if (const toml::node* jn = root.get("joints")) {
+    auto arr = jn->as_array();
+    if (!arr || !arr->is_array_of_tables()) r.fail(jn, "joints", "must be an array of tables ([[joints]])");
+    c.joint_values.resize(static_cast<long>(arr->size()));
+    c.joint_rates.resize(static_cast<long>(arr->size()));
+    for (size_t i = 0; i < arr->size(); ++i) {
+      const toml::table& jt = *arr->get(i)->as_table();
+      const std::string p = "joints." + std::to_string(i);
+      r.check_keys(jt, p, {"name", "type", "alpha", "a", "theta", "d", "value", "rate", "body"});
+      Joint j;
+      j.name = r.string(jt, p, "name", "joint" + std::to_string(i + 1));
+      const std::string type = r.string(jt, p, "type", std::string("revolute"));
+      if (type == "revolute") j.type = JointType::Revolute;
+      else if (type == "prismatic") j.type = JointType::Prismatic;
+      else r.fail(jt.get("type"), p + ".type", "must be \"revolute\" or \"prismatic\" (got \"" + type + "\")");
+      j.alpha = r.number(jt, p, "alpha", 0.0);
+      j.a = r.number(jt, p, "a", 0.0);
+      j.theta = r.number(jt, p, "theta", 0.0);
+      j.d = r.number(jt, p, "d", 0.0);
+      c.joint_values[static_cast<long>(i)] = r.number(jt, p, "value", 0.0);
+      c.joint_rates[static_cast<long>(i)] = r.number(jt, p, "rate", 0.0);
+      if (const toml::node* bn = jt.get("body")) {
+        if (!bn->is_table()) r.fail(bn, p + ".body", "must be a table");
+        j.H = read_body(r, *bn->as_table(), p + ".body", mats, secs);
+      }
+      c.joints.push_back(j);
+    }
+  }
+  if (!c.has_link && c.joints.empty()) r.fail(&root, "link", "a case needs a flexible link, joints, or both");
+
+  if (const toml::node* gn = root.get("gravity")) {
+    if (!gn->is_table()) r.fail(gn, "gravity", "must be a table");
+    r.check_keys(*gn->as_table(), "gravity", {"g"});
+    c.gravity = r.non_negative(*gn->as_table(), "gravity", "g", 0.0);
+  }
+  if (const toml::node* ln = root.get("loads")) {
+    if (!ln->is_table()) r.fail(ln, "loads", "must be a table");
+    r.check_keys(*ln->as_table(), "loads", {"tip_force", "tip_moment"});
+    c.loads.force = r.vec3(*ln->as_table(), "loads", "tip_force", Vec3::Zero());
+    c.loads.moment = r.vec3(*ln->as_table(), "loads", "tip_moment", Vec3::Zero());
+  }
+  return c;
+}
+
+Model build_model(const Case& c, int n) {
+  Discretisation d;
+  if (c.has_link) {
+    FlexibleLink link = c.link;
+    const int total = n > 0 ? n : c.n;
+    if (total > 0) {
+      try {
+        const auto parts = distribute_parts(link, total);
+        for (size_t s = 0; s < parts.size(); ++s) link.segments[s].parts = parts[s];
+      } catch (const std::invalid_argument& e) {
+        throw CaseError(c.path + ": link.n: " + e.what());
+      }
+    }
+    d = discretise(link);
+  }
+  return make_model(c.joints, c.mount, std::move(d), c.gravity);
+}
+
+}  // namespace rfem

@@ -1,0 +1,30 @@
+#pragma once
+// The rfe deformation transform D(q) = [R(φ) x; 0 1], R = RotX(φ1) RotY(φ2) RotZ(φ3)  [2.4],
+// with its first and second partial derivatives in the six rfe coordinates q = [x1 x2 x3 φ1 φ2 φ3].
+#include "core/types.hpp"
+
+namespace rfem {
+
+Mat3 rot_x(double a);
+Mat3 rot_y(double a);
+Mat3 rot_z(double a);
+/// Rotation from roll-pitch-yaw angles, R = RotZ(yaw) RotY(pitch) RotX(roll) (used for mounts).
+Mat3 rot_rpy(const Vec3& rpy);
+
+/// D and its derivatives at one configuration. Derivatives are stored as their top three rows
+/// (the bottom row of any derivative of a homogeneous transform is zero).
+struct DeformationTransform {
+  Mat4 D;
+  std::array<Mat34, 6> dD;          ///< ∂D/∂q_j
+  std::array<std::array<Mat3, 3>, 3> ddR;  ///< ∂²R/∂φ_a∂φ_b (translations enter D linearly)
+  std::array<Mat3, 3> dR;           ///< ∂R/∂φ_a
+};
+
+/// Evaluates D(q), ∂D/∂q and ∂²R/∂φ² for one rfe.
+void deformation_transform(const Vec6& q, DeformationTransform& out);
+
+/// Ḋ = Σ ∂D/∂q_j q̇_j and D̈ = Σ ∂D/∂q_j q̈_j + Σ ∂²D/∂q_j∂q_l q̇_j q̇_l (top rows).
+Mat34 d_dot(const DeformationTransform& d, const Vec6& v);
+Mat34 d_ddot(const DeformationTransform& d, const Vec6& v, const Vec6& a);
+
+}  // namespace rfem

@@ -1,0 +1,19 @@
+#pragma once
+// Exact results for a uniform cantilever (Euler–Bernoulli bending, rods in tension and torsion,
+// Timoshenko shear deflection), the references rfem's discretisation converges to.
+#include "core/link.hpp"
+#include "solvers/modes.hpp"
+
+namespace rfem::beam {
+
+/// k-th root (k ≥ 1) of 1 + cos x cosh x = 0: 1.875104, 4.694091, 7.854757, …
+double cantilever_beta_l(int k);
+/// k-th natural circular frequency [rad/s] of a uniform cantilever of the given kind.
+double cantilever_omega(const Segment& s, ModeKind kind, int k);
+/// Static tip deflection under a transverse tip force P along y (bending about z) or z:
+/// P L³/(3 E I) + P L/(κ G A).
+double cantilever_tip_deflection(const Segment& s, double P, bool along_z);
+/// Tip rotation P L²/(2 E I).
+double cantilever_tip_rotation(const Segment& s, double P, bool along_z);
+
+}  // namespace rfem::beam

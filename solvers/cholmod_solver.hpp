@@ -1,0 +1,38 @@
+#pragma once
+// CHOLMOD on the bordered pattern, in phases: analyse the pattern once (natural ordering: the
+// pattern has no fill), refactorise numerically whenever values change, solve. Simplicial LDLᵀ
+// (supernodes are tiny on this pattern; see shared/TOOLCHAIN.md).
+#include <vector>
+
+#include "assembly/pattern.hpp"
+#include "core/types.hpp"
+
+struct cholmod_common_struct;
+struct cholmod_sparse_struct;
+struct cholmod_factor_struct;
+
+namespace rfem {
+
+class CholmodSolver {
+ public:
+  explicit CholmodSolver(const BorderedPattern& pattern);
+  ~CholmodSolver();
+  CholmodSolver(const CholmodSolver&) = delete;
+  CholmodSolver& operator=(const CholmodSolver&) = delete;
+
+  /// Refactorises with new values (pattern order). Returns false if the matrix is not positive
+  /// definite (the caller may cut the step); the failing column is in failed_column().
+  bool factorize(const std::vector<double>& values);
+  /// Solves S x = b in place with the last successful factorisation.
+  void solve(VecX& b) const;
+  long failed_column() const { return failed_column_; }
+
+ private:
+  const BorderedPattern& pattern_;
+  cholmod_common_struct* common_ = nullptr;
+  cholmod_sparse_struct* A_ = nullptr;
+  cholmod_factor_struct* L_ = nullptr;
+  long failed_column_ = -1;
+};
+
+}  // namespace rfem

@@ -1,0 +1,143 @@
+#include "solvers/modes.hpp"
+
+#include <Spectra/SymEigsShiftSolver.h>
+
+#include <stdexcept>
+
+#include "assembly/assemble.hpp"
+#include "assembly/rfe_kernels.hpp"
+#include "solvers/cholmod_solver.hpp"
+#include "solvers/statics.hpp"
+
+namespace rfem {
+
+std::string to_string(ModeKind k) {
+  switch (k) {
+    case ModeKind::Axial: return "axial";
+    case ModeKind::BendingY: return "bending-y";
+    case ModeKind::BendingZ: return "bending-z";
+    case ModeKind::Torsion: return "torsion";
+  }
+  return "?";
+}
+
+namespace {
+
+// Block-diagonal M_ff and its per-block Cholesky factors.
+struct BlockMass {
+  std::vector<Mat6> M, L;
+};
+
+BlockMass block_mass(const Model& model, const VecX& q) {
+  BlockMass bm;
+  const int n = model.n();
+  bm.M.resize(n);
+  bm.L.resize(n);
+  BaseKinematics bk;
+  const VecX z = VecX::Zero(model.m());
+  base_kinematics(model, q.tail(model.m()), z, z, bk);
+  for (int k = 0; k < n; ++k) {
+    RfePose pose;
+    rfe_pose(model.link.rfes[k], bk, q.segment<6>(6 * k), Vec6::Zero(), Vec6::Zero(), pose);
+    MatX border;
+    Mat4 G;
+    rfe_mass_blocks(model.link.rfes[k], pose, bk, bm.M[k], border, G);
+    bm.L[k] = bm.M[k].llt().matrixL();
+  }
+  return bm;
+}
+
+// y = Lᵀ (K − σM)⁻¹ L x: shift-invert operator of the standard problem L⁻¹ K L⁻ᵀ u = λ u.
+class ShiftInvertOp {
+ public:
+  using Scalar = double;
+  ShiftInvertOp(const BorderedPattern& p, const std::vector<double>& K, const BlockMass& bm)
+      : pattern_(p), K_(K), bm_(bm), solver_(p) {}
+  Eigen::Index rows() const { return pattern_.size(); }
+  Eigen::Index cols() const { return pattern_.size(); }
+  void set_shift(double sigma) {
+    std::vector<double> S = K_;
+    for (int k = 0; k < pattern_.n_rfes(); ++k)
+      for (int l = 0; l < 6; ++l)
+        for (int j = 0; j <= l; ++j) S[pattern_.slot(6 * k + j, 6 * k + l)] -= sigma * bm_.M[k](j, l);
+    if (!solver_.factorize(S))
+      throw std::runtime_error("modal analysis: K − σM is not positive definite (is the link buckled?)");
+  }
+  void perform_op(const double* x, double* y) const {
+    const int n = pattern_.n_rfes();
+    VecX b(6 * n);
+    for (int k = 0; k < n; ++k) b.segment<6>(6 * k) = bm_.L[k] * Eigen::Map<const Vec6>(x + 6 * k);
+    solver_.solve(b);
+    for (int k = 0; k < n; ++k) Eigen::Map<Vec6>(y + 6 * k) = bm_.L[k].transpose() * b.segment<6>(6 * k);
+  }
+
+ private:
+  const BorderedPattern& pattern_;
+  const std::vector<double>& K_;
+  const BlockMass& bm_;
+  CholmodSolver solver_;
+};
+
+ModeKind classify(const VecX& phi, const BlockMass& bm) {
+  double w[4] = {0, 0, 0, 0};  // axial, bending-y (x2, φ3), bending-z (x3, φ2), torsion (φ1)
+  static const int kind_of[6] = {0, 1, 2, 3, 2, 1};
+  for (size_t k = 0; k < bm.M.size(); ++k)
+    for (int i = 0; i < 6; ++i) w[kind_of[i]] += bm.M[k](i, i) * phi[6 * k + i] * phi[6 * k + i];
+  int best = 0;
+  for (int i = 1; i < 4; ++i)
+    if (w[i] > w[best]) best = i;
+  return static_cast<ModeKind>(best);
+}
+
+}  // namespace
+
+ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, int count, int dense_limit) {
+  const int n = model.n(), N = 6 * n;
+  if (n == 0) throw std::invalid_argument("modal analysis needs a flexible link (n ≥ 1)");
+  if (count < 1 || count > N) throw std::invalid_argument("mode count must be between 1 and 6n = " + std::to_string(N));
+  ModesResult res;
+  res.q0 = solve_static(model, qb, vb, TipLoads{}).q;
+  VecX v = VecX::Zero(model.dof());
+  v.tail(model.m()) = vb;
+  const BorderedPattern pattern(n, 0);
+  MatrixTerms terms;
+  terms.stiffness = 1.0;
+  terms.gravity = true;
+  terms.inertial = vb.size() > 0 && vb.norm() > 0.0;
+  std::vector<double> K;
+  assemble_matrix(model, pattern, std::vector<int>(model.m(), -1), res.q0, v, terms, K);
+  const BlockMass bm = block_mass(model, res.q0);
+  VecX lambda;
+  if (N <= dense_limit) {
+    MatX Md = MatX::Zero(N, N);
+    for (int k = 0; k < n; ++k) Md.block<6, 6>(6 * k, 6 * k) = bm.M[k];
+    Eigen::GeneralizedSelfAdjointEigenSolver<MatX> es(to_dense(pattern, K), Md);
+    if (es.info() != Eigen::Success) throw std::runtime_error("modal analysis: dense eigen-solver failed");
+    lambda = es.eigenvalues().head(count);
+    res.shapes = es.eigenvectors().leftCols(count);
+  } else {
+    res.dense = false;
+    ShiftInvertOp op(pattern, K, bm);
+    const int ncv = std::min(N, std::max(2 * count + 1, count + 20));
+    Spectra::SymEigsShiftSolver<ShiftInvertOp> eigs(op, count, ncv, 0.0);
+    eigs.init();
+    eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
+    if (eigs.info() != Spectra::CompInfo::Successful) throw std::runtime_error("modal analysis: Lanczos did not converge");
+    const VecX ev = eigs.eigenvalues();
+    const MatX U = eigs.eigenvectors();
+    // Spectra returns the eigenvalues of A (back-transformed), largest 1/(λ−σ) first: reverse.
+    lambda.resize(count);
+    res.shapes.resize(N, count);
+    for (int i = 0; i < count; ++i) {
+      lambda[i] = ev[count - 1 - i];
+      VecX u = U.col(count - 1 - i);
+      for (int k = 0; k < n; ++k)  // φ = L⁻ᵀ u
+        res.shapes.col(i).segment<6>(6 * k) = bm.L[k].transpose().triangularView<Eigen::Upper>().solve(u.segment<6>(6 * k));
+    }
+  }
+  res.omega = lambda.cwiseMax(0.0).cwiseSqrt();
+  for (int i = 0; i < count; ++i) res.kind.push_back(classify(res.shapes.col(i), bm));
+  return res;
+}
+
+}  // namespace rfem
