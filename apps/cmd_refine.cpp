@@ -27,18 +27,23 @@ double evaluate_quantity(const Case& cs, int n, const std::string& quantity, con
     k = 0;
   }
   if (k < 1) throw CaseError("--quantity " + quantity + ": expected NAME:K with K ≥ 1");
-  const int count = std::min(6 * model.n(), what == "mode" ? k : 4 * k + 8);
-  const ModesResult r = compute_modes(model, qb, vb, count);
-  if (what == "mode") {
-    if (k > count) throw CaseError("--quantity " + quantity + ": n = " + std::to_string(n) + " has only " + std::to_string(count) + " modes");
-    return r.omega[k - 1] / (2 * M_PI);
-  }
-  int seen = 0;
-  for (int i = 0; i < count; ++i)
-    if (to_string(r.kind[i]) == what && ++seen == k) return r.omega[i] / (2 * M_PI);
-  if (what != "axial" && what != "bending-y" && what != "bending-z" && what != "torsion")
+  if (what != "mode" && what != "axial" && what != "bending-y" && what != "bending-z" && what != "torsion")
     throw CaseError("--quantity " + quantity + ": unknown quantity '" + what + "'");
-  throw std::runtime_error("--quantity " + quantity + ": no such mode among the lowest " + std::to_string(count) +
+  if (what == "mode") {
+    if (k > 6 * model.n()) throw CaseError("--quantity " + quantity + ": n = " + std::to_string(n) + " has only " + std::to_string(6 * model.n()) + " modes");
+    return compute_modes(model, qb, vb, k).omega[k - 1] / (2 * M_PI);
+  }
+  // Modes of one kind can sit high in the spectrum (axial modes of a slender beam): widen the
+  // search until the k-th one appears.
+  for (int count = std::min(6 * model.n(), 4 * k + 8);; count = std::min(6 * model.n(), 2 * count)) {
+    const ModesResult r = compute_modes(model, qb, vb, count);
+    int seen = 0;
+    for (int i = 0; i < count; ++i)
+      if (to_string(r.kind[i]) == what && ++seen == k) return r.omega[i] / (2 * M_PI);
+    if (count == 6 * model.n()) break;
+  }
+  const int count = 6 * model.n();
+  throw std::runtime_error("--quantity " + quantity + ": no such mode among all " + std::to_string(count) +
                            " at n = " + std::to_string(n));
 }
 

@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Installs the dependencies (Debian 12, root), builds rfem and runs the main examples:
+# Kane's beam modes and refinement, the paper's link 3 modes, and a static tip load.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install-deps.sh
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j "$(nproc)"
+set -x
+build/apps/rfem modes cases/kane_beam.toml --count 8
+build/apps/rfem refine cases/kane_beam.toml --n 5,10,20,40,80 --quantity bending-y:1
+build/apps/rfem static cases/kane_beam.toml
+build/apps/rfem modes cases/paper_link3.toml --n 60 --count 8
+build/apps/rfem modes cases/kane_spinup.toml --rate 6 --count 4

@@ -1,0 +1,126 @@
+// Cantilever convergence (FORMULATION.md §7 invariants 5 and 6): bending frequencies in both
+// planes, axial and torsional frequencies, static tip deflection and rotation converge to exact
+// beam theory with observed order ≈ 2. Kane's beam, with Iz raised to 3e-7 m⁴ so that the two
+// bending planes are distinct.
+//
+// RFEM converges to a beam with shear flexibility and rotary inertia (Timoshenko), so the
+// Richardson-extrapolated frequency differs from Euler–Bernoulli by at most
+// (βL)²(r/L)²(1 + E/κG) (r² = I/A): that is the tolerance for the extrapolated values.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "apps/commands.hpp"
+#include "solvers/beam_theory.hpp"
+#include "solvers/modes.hpp"
+#include "tests/test_models.hpp"
+
+using namespace rfem;
+
+namespace {
+
+Case kane() { return read_case(test::source_path("cases/kane_beam.toml"), {"sections.kane.Iz=3e-7"}); }
+
+struct Series {
+  std::vector<double> v;
+  double order() const { return std::log2(std::abs((v[1] - v[0]) / (v[2] - v[1]))); }  // n doubles
+  double richardson() const { return v[2] + (v[2] - v[1]) / (std::pow(2.0, order()) - 1.0); }
+};
+
+Series series(const Case& c, const std::string& q, std::vector<int> ns = {20, 40, 80}) {
+  Series s;
+  for (int n : ns) s.v.push_back(app::evaluate_quantity(c, n, q, {}));
+  return s;
+}
+
+double timoshenko_bound(const Segment& s, double beta_l, double I) {
+  const double r2 = I / s.section.A;
+  return beta_l * beta_l * r2 / (s.length * s.length) * (1.0 + s.material.E / (s.section.kappa_y * s.material.G));
+}
+
+}  // namespace
+
+TEST(Cantilever, BendingFrequenciesConvergeWithOrderTwoInBothPlanes) {
+  const Case c = kane();
+  const Segment& seg = c.link.segments[0];
+  for (const auto& [kind, name, I] : {std::tuple{ModeKind::BendingY, "bending-y", seg.section.Iz},
+                                      std::tuple{ModeKind::BendingZ, "bending-z", seg.section.Iy}}) {
+    for (int k = 1; k <= 3; ++k) {
+      const Series s = series(c, std::string(name) + ":" + std::to_string(k));
+      const double exact = beam::cantilever_omega(seg, kind, k) / (2 * M_PI);
+      EXPECT_NEAR(s.order(), 2.0, 0.15) << name << k;
+      EXPECT_LT(std::abs(s.richardson() / exact - 1.0), timoshenko_bound(seg, beam::cantilever_beta_l(k), I))
+          << name << k;
+      const double tol_n40[3] = {1e-3, 3e-3, 5e-3};  // the acceptance figures
+      EXPECT_LT(std::abs(s.v[1] / exact - 1.0), tol_n40[k - 1]) << name << k << " at n = 40";
+    }
+  }
+  EXPECT_NEAR(beam::cantilever_beta_l(1), 1.875104, 1e-6);
+  EXPECT_NEAR(beam::cantilever_beta_l(2), 4.694091, 1e-6);
+  EXPECT_NEAR(beam::cantilever_beta_l(3), 7.854757, 1e-6);
+}
+
+TEST(Cantilever, AxialAndTorsionalFrequenciesConverge) {
+  const Case c = kane();
+  const Segment& seg = c.link.segments[0];
+  for (const auto& [kind, name] : {std::pair{ModeKind::Axial, "axial"}, std::pair{ModeKind::Torsion, "torsion"}}) {
+    for (int k = 1; k <= 2; ++k) {
+      const Series s = series(c, std::string(name) + ":" + std::to_string(k));
+      const double exact = beam::cantilever_omega(seg, kind, k) / (2 * M_PI);
+      EXPECT_NEAR(s.order(), 2.0, 0.1) << name << k;
+      // Rods have no shear/rotary correction: the extrapolation is limited by the O(n⁻⁴) term.
+      EXPECT_LT(std::abs(s.richardson() / exact - 1.0), 1e-5) << name << k;
+    }
+  }
+}
+
+TEST(Cantilever, StaticTipDeflectionAndRotation) {
+  const Case c = kane();  // 1 N tip force along −z: bending about y (Iy)
+  const Segment& seg = c.link.segments[0];
+  const double P = -1.0;
+  const Series w = series(c, "tip:uz", {10, 20, 40});
+  const Series r = series(c, "tip:ry", {10, 20, 40});
+  EXPECT_NEAR(w.order(), 2.0, 0.1);
+  // Geometric nonlinearity at this load changes the tip deflection by ~(w/L)² ≈ 6e-6 relative.
+  EXPECT_NEAR(w.richardson(), beam::cantilever_tip_deflection(seg, P, true), 2e-5 * std::abs(w.v[2]));
+  // The tip rotation of rfe_n (half an rfe from the tip) converges to PL²/2EI too; ry = −dw/dx.
+  EXPECT_NEAR(r.richardson(), -beam::cantilever_tip_rotation(seg, P, true), 2e-5 * std::abs(r.v[2]));
+}
+
+TEST(Cantilever, LanczosMatchesDenseEigenSolver) {
+  const Case c = kane();
+  const Model m = build_model(c, 150);
+  const VecX qb, vb;
+  const ModesResult dense = compute_modes(m, qb, vb, 6 * m.n(), 100000);
+  const ModesResult lanczos = compute_modes(m, qb, vb, 8, 0);
+  ASSERT_FALSE(lanczos.dense);
+  // The dense solver's eigenvalues carry an absolute error ~ε λ_max (axial modes make
+  // λ_max/λ_1 ~ 1e9 here); shift-invert is accurate near σ = 0. Allow 100 ε (ω_max/ω_i)².
+  const double wmax = dense.omega.maxCoeff();
+  for (int i = 0; i < 8; ++i) {
+    const double tol = 100 * 2.2e-16 * std::pow(wmax / dense.omega[i], 2);
+    EXPECT_NEAR(lanczos.omega[i] / dense.omega[i], 1.0, tol) << "mode " << i + 1;
+  }
+}
+
+TEST(RotatingBeam, SouthwellCoefficients) {
+  // Kane's beam on a hub turning about z: ω² = ω₀² + K Ω². Flapwise (deflection along the rotation
+  // axis) K₁ = 1.193 for a uniform cantilever with zero hub radius (Wright et al. 1982); in the
+  // plane of rotation centrifugal softening subtracts exactly Ω², so K_lag = K_flap − 1.
+  // Small Ω = 0.1 rad/s keeps the quadratic law exact to ~(Ω/ω₀)² = 1e-3 relative in K.
+  const Case c = read_case(test::source_path("cases/kane_spinup.toml"), {"sections.kane.Iz=3e-7"});
+  const Model m = build_model(c, 80);
+  const VecX qb = VecX::Zero(1), v0 = VecX::Zero(1), v1 = VecX::Constant(1, 0.1);
+  const ModesResult a = compute_modes(m, qb, v0, 2), b = compute_modes(m, qb, v1, 2);
+  auto K = [&](ModeKind kind) {
+    double w0 = 0, w1 = 0;
+    for (int i = 0; i < 2; ++i) {
+      if (a.kind[i] == kind) w0 = a.omega[i];
+      if (b.kind[i] == kind) w1 = b.omega[i];
+    }
+    return (w1 * w1 - w0 * w0) / 0.01;
+  };
+  const double flap = K(ModeKind::BendingZ), lag = K(ModeKind::BendingY);
+  EXPECT_NEAR(flap, 1.193, 0.005);
+  EXPECT_NEAR(flap - lag, 1.0, 0.005);
+}

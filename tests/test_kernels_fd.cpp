@@ -1,0 +1,208 @@
+// Finite-difference checks of every kernel's derivatives (FORMULATION.md §7 invariants 1 and 2):
+// M against the kinetic energy, the inertial force against Lagrange's equations, sde and gravity
+// forces against their energies, stiffness and damping matrices against the forces.
+// Central differences with step h have truncation error ~h²·|f'''| and round-off ~ε|f|/h; with
+// h = 1e-5 both are below 1e-8 relative, so 1e-6 relative to the matrix norm is a safe bound that
+// any wrong term (of relative size ≥ 1e-4 in these random states) would exceed.
+#include <gtest/gtest.h>
+
+#include <functional>
+
+#include "assembly/assemble.hpp"
+#include "assembly/dense_reference.hpp"
+#include "solvers/statics.hpp"
+#include "tests/test_models.hpp"
+
+using namespace rfem;
+
+namespace {
+
+constexpr double h = 1e-5;
+
+// Jacobian of a vector function by central differences.
+MatX fd_jacobian(const std::function<VecX(const VecX&)>& f, const VecX& x, double step = h) {
+  const VecX f0 = f(x);
+  MatX J(f0.size(), x.size());
+  for (int i = 0; i < x.size(); ++i) {
+    VecX xp = x, xm = x;
+    xp[i] += step;
+    xm[i] -= step;
+    J.col(i) = (f(xp) - f(xm)) / (2 * step);
+  }
+  return J;
+}
+
+VecX fd_gradient(const std::function<double(const VecX&)>& f, const VecX& x, double step = h) {
+  VecX g(x.size());
+  for (int i = 0; i < x.size(); ++i) {
+    VecX xp = x, xm = x;
+    xp[i] += step;
+    xm[i] -= step;
+    g[i] = (f(xp) - f(xm)) / (2 * step);
+  }
+  return g;
+}
+
+double rel(const MatX& A, const MatX& B) { return (A - B).norm() / std::max(B.norm(), 1e-300); }
+
+ForceTerms only(bool inertia, bool gravity, bool sde) {
+  ForceTerms t;
+  t.inertia = inertia;
+  t.gravity = gravity;
+  t.sde = sde;
+  return t;
+}
+
+MatX assembled(const Model& m, const VecX& q, const VecX& v, const MatrixTerms& t) {
+  const BorderedPattern p(m.n(), m.m());
+  std::vector<int> cols(m.m());
+  for (int j = 0; j < m.m(); ++j) cols[j] = 6 * m.n() + j;
+  std::vector<double> vals;
+  assemble_matrix(m, p, cols, q, v, t, vals);
+  return to_dense(p, vals);
+}
+
+}  // namespace
+
+TEST(KernelsFD, MassMatrixIsHessianOfKineticEnergy) {
+  const Model m = test::spatial_arm(4);
+  VecX q, v, a;
+  test::random_state(m, 1, q, v, a);
+  MatrixTerms t;
+  t.mass = 1.0;
+  const MatX M = assembled(m, q, v, t);
+  // T is quadratic in q̇: ∂T/∂q̇ = M q̇, so the Jacobian of the FD gradient is M.
+  auto grad = [&](const VecX& vv) {
+    return fd_gradient([&](const VecX& x) { return energies(m, q, x).kinetic; }, vv, 1e-3);
+  };
+  const MatX Mfd = fd_jacobian(grad, v, 1e-3);
+  EXPECT_LT(rel(M, Mfd), 1e-6);
+  EXPECT_LT(rel(M, M.transpose()), 1e-15);
+  Eigen::SelfAdjointEigenSolver<MatX> es(M);
+  EXPECT_GT(es.eigenvalues().minCoeff(), 0.0) << "M must be positive definite";
+}
+
+TEST(KernelsFD, InertialForceSatisfiesLagrangeEquations) {
+  const Model m = test::spatial_arm(3);
+  VecX q, v, a;
+  test::random_state(m, 2, q, v, a);
+  VecX eps;
+  generalised_forces(m, q, v, a, only(true, false, false), eps);
+  MatrixTerms t;
+  t.mass = 1.0;
+  // d/dt (M(q(t)) v(t)) along q(t) = q + v t + a t²/2, minus ∂T/∂q.
+  auto momentum = [&](double s) {
+    const VecX qs = q + v * s + 0.5 * a * s * s, vs = v + a * s;
+    return VecX(assembled(m, qs, vs, t) * vs);
+  };
+  const double dt = 1e-5;
+  const VecX dpdt = (momentum(dt) - momentum(-dt)) / (2 * dt);
+  const VecX dTdq = fd_gradient([&](const VecX& x) { return energies(m, x, v).kinetic; }, q);
+  EXPECT_LT(rel(eps, dpdt - dTdq), 1e-6);
+}
+
+TEST(KernelsFD, ForcesAreGradientsOfEnergies) {
+  const Model m = test::spatial_arm(5);
+  VecX q, v, a;
+  test::random_state(m, 3, q, v, a);
+  const VecX zero = VecX::Zero(m.dof());
+  VecX fe, fg;
+  generalised_forces(m, q, zero, zero, only(false, false, true), fe);
+  generalised_forces(m, q, zero, zero, only(false, true, false), fg);
+  EXPECT_LT(rel(fe, fd_gradient([&](const VecX& x) { return energies(m, x, zero).elastic; }, q)), 1e-6);
+  EXPECT_LT(rel(fg, fd_gradient([&](const VecX& x) { return energies(m, x, zero).gravity; }, q)), 1e-6);
+}
+
+TEST(KernelsFD, StiffnessIsJacobianOfElasticAndGravityForces) {
+  const Model m = test::spatial_arm(4);
+  VecX q, v, a;
+  test::random_state(m, 4, q, v, a);
+  const VecX zero = VecX::Zero(m.dof());
+  MatrixTerms t;
+  t.stiffness = 1.0;
+  t.gravity = true;
+  const MatX K = assembled(m, q, zero, t);
+  const MatX Kfd = fd_jacobian(
+      [&](const VecX& x) {
+        VecX f;
+        generalised_forces(m, x, zero, zero, only(false, true, true), f);
+        return f;
+      },
+      q);
+  EXPECT_LT(rel(K, Kfd), 1e-6);
+  EXPECT_LT(rel(dense_stiffness(m, q, true), Kfd), 1e-6);
+}
+
+TEST(KernelsFD, DampingMatrixIsJacobianOfDampingForces) {
+  const Model m = test::spatial_arm(4, 0.01);
+  VecX q, v, a;
+  test::random_state(m, 5, q, v, a);
+  const VecX zero = VecX::Zero(m.dof());
+  MatrixTerms t;
+  t.damping = 1.0;
+  const MatX C = assembled(m, q, v, t);
+  auto fd = [&](const VecX& x) {
+    VecX f;
+    generalised_forces(m, q, x, zero, only(false, false, true), f);
+    return f;
+  };
+  EXPECT_LT(rel(C, fd_jacobian(fd, v)), 1e-6);
+  // Dissipated power equals q̇ · f_damping (Rayleigh function of degree 2).
+  VecX f0;
+  generalised_forces(m, q, zero, zero, only(false, false, true), f0);
+  EXPECT_NEAR(energies(m, q, v).dissipation_rate, v.dot(fd(v) - f0), 1e-9 * std::abs(v.dot(fd(v) - f0)));
+}
+
+TEST(KernelsFD, CentrifugalStiffnessIsJacobianOfInertialForce) {
+  const Model m = test::spatial_arm(3);
+  VecX q, v, a;
+  test::random_state(m, 6, q, v, a);
+  v.head(6 * m.n()).setZero();  // the steady-rotation state: rfes at rest in {r}
+  const VecX zero = VecX::Zero(m.dof());
+  MatrixTerms t;
+  t.stiffness = 1.0;
+  t.inertial = true;
+  const BorderedPattern p(m.n(), 0);
+  std::vector<double> vals;
+  assemble_matrix(m, p, std::vector<int>(m.m(), -1), q, v, t, vals);
+  const MatX Kc = to_dense(p, vals);
+  t.inertial = false;
+  assemble_matrix(m, p, std::vector<int>(m.m(), -1), q, v, t, vals);
+  const MatX Kinertial = Kc - to_dense(p, vals);
+  const int Nf = 6 * m.n();
+  const MatX Kfd = fd_jacobian(
+      [&](const VecX& x) {
+        VecX qq = q;
+        qq.head(Nf) = x;
+        VecX f;
+        generalised_forces(m, qq, v, zero, only(true, false, false), f);
+        return VecX(f.head(Nf));
+      },
+      q.head(Nf));
+  // Only rfe-diagonal blocks exist in the kernel; compare the symmetric part of those blocks.
+  MatX Kfd_blocks = MatX::Zero(Nf, Nf);
+  for (int k = 0; k < m.n(); ++k) {
+    const Mat6 b = Kfd.block<6, 6>(6 * k, 6 * k);
+    Kfd_blocks.block<6, 6>(6 * k, 6 * k) = 0.5 * (b + b.transpose());
+  }
+  EXPECT_LT(rel(Kinertial, Kfd_blocks), 1e-6);
+}
+
+TEST(KernelsFD, TipForceDoesVirtualWork) {
+  const Model m = test::spatial_arm(3);
+  VecX q, v, a;
+  test::random_state(m, 7, q, v, a);
+  TipLoads loads;
+  loads.force = Vec3(1.0, -2.0, 3.0);
+  const int n = m.n();
+  const Vec6 Q = tip_generalised_force(m, q.segment<6>(6 * (n - 1)), loads);
+  // Q_j = F · ∂p_tip/∂q_j
+  const VecX g = fd_gradient(
+      [&](const VecX& x) {
+        VecX qq = q;
+        qq.segment<6>(6 * (n - 1)) = x;
+        return loads.force.dot(tip_motion(m, qq).head<3>());
+      },
+      VecX(q.segment<6>(6 * (n - 1))));
+  EXPECT_LT((Q - g).norm(), 1e-8 * Q.norm());
+}
