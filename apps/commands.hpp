@@ -28,6 +28,8 @@ struct ModesOptions {
 
 int run_static(const Common& c);
 int run_modes(const Common& c, const ModesOptions& o);
+/// `rfem run`: time integration of the case's [simulation], results to an HDF5 file.
+int run_simulation(const Common& c, const std::string& output);
 int run_refine(const Common& c, const std::vector<int>& ns, const std::string& quantity, const ModesOptions& o);
 
 /// Joint values and rates of the case, with --rate applied.

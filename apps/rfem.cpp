@@ -37,6 +37,10 @@ int main(int argc, char** argv) {
   add_common(md);
   md->add_option("--count", mo.count, "number of modes")->check(CLI::PositiveNumber);
   add_rate(md);
+  auto* rn = app.add_subcommand("run", "time integration of the case's [simulation]; results to HDF5");
+  add_common(rn);
+  std::string output;
+  rn->add_option("-o,--output", output, "results file (default: the case name with .h5, here)");
   auto* rf = app.add_subcommand("refine", "convergence table of a quantity over a series of n");
   add_common(rf);
   std::string ns_text = "5,10,20,40,80", quantity = "mode:1";
@@ -59,6 +63,13 @@ int main(int argc, char** argv) {
   try {
     if (st->parsed()) return run_static(common);
     if (md->parsed()) return run_modes(common, mo);
+    if (rn->parsed()) {
+      if (output.empty()) {
+        std::string stem = common.case_path.substr(common.case_path.find_last_of('/') + 1);
+        output = stem.substr(0, stem.rfind('.')) + ".h5";
+      }
+      return run_simulation(common, output);
+    }
     if (rf->parsed()) {
       std::vector<int> ns;
       std::stringstream ss(ns_text);

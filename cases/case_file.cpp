@@ -279,6 +279,68 @@ Mat4 read_body(const Reader& r, const toml::table& t, const std::string& path,
   return pseudo_inertia(mass, com, I);
 }
 
+InputSpec read_input(const Reader& r, const toml::table& t, const std::string& path, const std::string& case_dir) {
+  InputSpec in;
+  std::ostringstream where;  // (ostringstream: GCC 12 warns falsely on ":" + std::to_string)
+  where << r.file();
+  if (t.source().begin.line) where << ":" << t.source().begin.line;
+  where << ": " << path;
+  in.where = where.str();
+  in.kind = r.string(t, path, "kind");
+  auto file_key = [&]() {
+    const std::string f = r.string(t, path, "file");
+    in.file = (f.empty() || f[0] == '/') ? f : case_dir + f;
+    if (!std::ifstream(in.file)) r.fail(t.get("file"), path + ".file", "cannot open '" + in.file + "'");
+  };
+  if (in.kind == "deployment") {
+    r.check_keys(t, path, {"kind", "alpha", "T"});
+    in.alpha = r.number(t, path, "alpha");
+    in.T = r.positive(t, path, "T");
+  } else if (in.kind == "spinup") {
+    r.check_keys(t, path, {"kind", "Omega", "T"});
+    in.Omega = r.number(t, path, "Omega");
+    in.T = r.positive(t, path, "T");
+  } else if (in.kind == "constant_rate") {
+    r.check_keys(t, path, {"kind", "rate"});
+    in.rate = r.number(t, path, "rate");
+  } else if (in.kind == "table" || in.kind == "torque_table") {
+    r.check_keys(t, path, {"kind", "file"});
+    file_key();
+  } else if (in.kind == "torque") {
+    r.check_keys(t, path, {"kind", "value"});
+    in.value = r.number(t, path, "value", 0.0);
+  } else if (in.kind == "torque_from_run") {
+    r.check_keys(t, path, {"kind", "file", "run", "joint"});
+    file_key();
+    in.run = r.string(t, path, "run");
+    in.joint = static_cast<int>(r.integer(t, path, "joint", 0, 1));
+  } else {
+    r.fail(t.get("kind"), path + ".kind",
+           "unknown input '" + in.kind + "' (deployment, spinup, constant_rate, table, torque, torque_table, torque_from_run)");
+  }
+  return in;
+}
+
+Simulation read_simulation(const Reader& r, const toml::table& t) {
+  const std::string p = "simulation";
+  r.check_keys(t, p, {"t_end", "output_dt", "rtol", "atol", "atol_velocity", "max_step", "procedure", "store_flexible_every", "max_order"});
+  Simulation s;
+  s.t_end = r.positive(t, p, "t_end");
+  s.output_dt = r.positive(t, p, "output_dt", std::min(0.01, s.t_end));
+  if (s.output_dt > s.t_end) r.fail(t.get("output_dt"), p + ".output_dt", "must not exceed t_end");
+  s.rtol = r.positive(t, p, "rtol", 1e-6);
+  s.atol = r.positive(t, p, "atol", 1e-8);
+  s.atol_velocity = r.positive(t, p, "atol_velocity", 1e-5);
+  s.max_step = r.non_negative(t, p, "max_step", 0.0);
+  s.procedure = r.string(t, p, "procedure", std::string("single"));
+  if (s.procedure != "single" && s.procedure != "paper")
+    r.fail(t.get("procedure"), p + ".procedure", "must be \"single\" or \"paper\" (got \"" + s.procedure + "\")");
+  s.flexible_every = static_cast<int>(r.integer(t, p, "store_flexible_every", 0, 0));
+  s.max_order = static_cast<int>(r.integer(t, p, "max_order", 2, 1));
+  if (s.max_order > 5) r.fail(t.get("max_order"), p + ".max_order", "must be between 1 and 5");
+  return s;
+}
+
 }  // namespace
 
 Case read_case(const std::string& path, const std::vector<std::string>& overrides) {
@@ -299,7 +361,9 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
   }
   for (const auto& o : overrides) apply_override(root, path, o);
   const Reader r(path);
-  r.check_keys(root, "", {"case", "materials", "sections", "link", "joints", "gravity", "loads"});
+  r.check_keys(root, "", {"case", "materials", "sections", "link", "joints", "gravity", "loads", "simulation"});
+  const auto slash = path.find_last_of('/');
+  const std::string case_dir = slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
 
   if (const toml::node* n = root.get("case")) {
     if (!n->is_table()) r.fail(n, "case", "must be a table");
@@ -354,7 +418,7 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
     for (size_t i = 0; i < arr->size(); ++i) {
       const toml::table& jt = *arr->get(i)->as_table();
       const std::string p = "joints." + std::to_string(i);
-      r.check_keys(jt, p, {"name", "type", "alpha", "a", "theta", "d", "value", "rate", "body"});
+      r.check_keys(jt, p, {"name", "type", "alpha", "a", "theta", "d", "value", "rate", "body", "input"});
       Joint j;
       j.name = r.string(jt, p, "name", "joint" + std::to_string(i + 1));
       const std::string type = r.string(jt, p, "type", std::string("revolute"));
@@ -371,6 +435,12 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
         if (!bn->is_table()) r.fail(bn, p + ".body", "must be a table");
         j.H = read_body(r, *bn->as_table(), p + ".body", mats, secs);
       }
+      InputSpec in;
+      if (const toml::node* inn = jt.get("input")) {
+        if (!inn->is_table()) r.fail(inn, p + ".input", "must be a table {kind = …}");
+        in = read_input(r, *inn->as_table(), p + ".input", case_dir);
+      }
+      c.inputs.push_back(in);
       c.joints.push_back(j);
     }
   }
@@ -380,6 +450,11 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
     if (!gn->is_table()) r.fail(gn, "gravity", "must be a table");
     r.check_keys(*gn->as_table(), "gravity", {"g"});
     c.gravity = r.non_negative(*gn->as_table(), "gravity", "g", 0.0);
+  }
+  if (const toml::node* sn = root.get("simulation")) {
+    if (!sn->is_table()) r.fail(sn, "simulation", "must be a table");
+    c.sim = read_simulation(r, *sn->as_table());
+    c.has_simulation = true;
   }
   if (const toml::node* ln = root.get("loads")) {
     if (!ln->is_table()) r.fail(ln, "loads", "must be a table");

@@ -17,6 +17,25 @@ class CaseError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A joint's input in a time integration (`joints[].input`); the kinds are documented in README.md.
+struct InputSpec {
+  std::string kind = "torque";  ///< deployment | spinup | constant_rate | table | torque | torque_table | torque_from_run
+  double alpha = 0, T = 0, Omega = 0, rate = 0, value = 0;
+  std::string file;  ///< table or results file, resolved relative to the case file
+  std::string run;   ///< group in a results file
+  int joint = 0;     ///< joint (1-based) of the results file; 0: the same joint
+  std::string where; ///< "file:line: joints.i.input" for later error messages
+  bool prescribed() const { return kind == "deployment" || kind == "spinup" || kind == "constant_rate" || kind == "table"; }
+};
+
+/// The `[simulation]` table: time integration settings.
+struct Simulation {
+  double t_end = 1.0, output_dt = 0.01, rtol = 1e-6, atol = 1e-8, atol_velocity = 1e-5, max_step = 0.0;
+  std::string procedure = "single";  ///< single | paper (rigid inverse dynamics, kinematic, force input)
+  int flexible_every = 0;            ///< store the full flexible state every k outputs (0: never)
+  int max_order = 2;                 ///< highest BDF order (2: A-stable over undamped stiff sde modes)
+};
+
 struct Case {
   std::string path;
   std::string text;  ///< the file as read (stored with results)
@@ -29,6 +48,9 @@ struct Case {
   VecX joint_values, joint_rates;  ///< initial/held values and steady rates
   double gravity = 0.0;
   TipLoads loads;
+  std::vector<InputSpec> inputs;  ///< one per joint
+  Simulation sim;
+  bool has_simulation = false;
 };
 
 /// Reads and validates a case; `overrides` are "key.path=value" strings applied before checking

@@ -16,4 +16,13 @@ Model make_model(std::vector<Joint> joints, const Mat4& mount, Discretisation li
   return m;
 }
 
+Model rigidify(const Model& model) {
+  std::vector<Joint> joints = model.joints;
+  for (const Rfe& r : model.link.rfes) {
+    const Mat4 X = model.mount * homogeneous(Mat3::Identity(), r.centre);
+    joints.back().H += X * r.H * X.transpose();
+  }
+  return make_model(std::move(joints), model.mount, Discretisation{}, model.gravity);
+}
+
 }  // namespace rfem

@@ -23,4 +23,8 @@ struct Model {
 /// Assembles a model; adds rfe_0's inertia to the last base link (FORMULATION.md §2).
 Model make_model(std::vector<Joint> joints, const Mat4& mount, Discretisation link, double gravity);
 
+/// The rigid manipulator of a model (n = 0): every rfe's inertia added to the carrying link, as if
+/// the flexible link were infinitely stiff. Needs at least one joint.
+Model rigidify(const Model& model);
+
 }  // namespace rfem

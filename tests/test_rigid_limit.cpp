@@ -57,13 +57,7 @@ TEST(RigidLimit, TwoLinkArmClosedForm) {
 
 TEST(RigidLimit, UndeformedFlexibleLinkActsAsRigidBody) {
   const Model flex = test::spatial_arm(12);
-  // The rigid equivalent: every rfe's pseudo-inertia moved into the last link's frame.
-  std::vector<Joint> joints = flex.joints;
-  for (const Rfe& r : flex.link.rfes) {
-    const Mat4 X = flex.mount * homogeneous(Mat3::Identity(), r.centre);
-    joints.back().H += X * r.H * X.transpose();
-  }
-  const Model rigid = make_model(joints, flex.mount, Discretisation{}, flex.gravity);
+  const Model rigid = rigidify(flex);  // every rfe's pseudo-inertia moved into the last link
   VecX q, v, a;
   test::random_state(flex, 21, q, v, a);
   const int Nf = 6 * flex.n();

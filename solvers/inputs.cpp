@@ -1,0 +1,172 @@
+#include "solvers/inputs.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace rfem {
+
+namespace {
+
+class Deployment : public MotionLaw {
+ public:
+  Deployment(double psi0, double alpha, double T) : psi0_(psi0), k_(M_PI * alpha / (2 * T)), T_(T) {}
+  MotionSample at(double t) const override {
+    if (t >= T_) return {psi0_ - k_ * T_, 0.0, 0.0};
+    const double w = 2 * M_PI / T_;
+    return {psi0_ - k_ * (t - std::sin(w * t) / w), -k_ * (1 - std::cos(w * t)), -k_ * w * std::sin(w * t)};
+  }
+
+ private:
+  double psi0_, k_, T_;
+};
+
+class Spinup : public MotionLaw {
+ public:
+  Spinup(double th0, double Omega, double T) : th0_(th0), W_(Omega), T_(T) {}
+  MotionSample at(double t) const override {
+    if (t >= T_) return {th0_ + W_ * (t - T_ / 2), W_, 0.0};
+    const double w = 2 * M_PI / T_;
+    return {th0_ + (W_ / T_) * (t * t / 2 + (std::cos(w * t) - 1) / (w * w)), (W_ / T_) * (t - std::sin(w * t) / w),
+            (W_ / T_) * (1 - std::cos(w * t))};
+  }
+
+ private:
+  double th0_, W_, T_;
+};
+
+class ConstantRate : public MotionLaw {
+ public:
+  ConstantRate(double q0, double rate) : q0_(q0), rate_(rate) {}
+  MotionSample at(double t) const override { return {q0_ + rate_ * t, rate_, 0.0}; }
+
+ private:
+  double q0_, rate_;
+};
+
+class Spline : public MotionLaw {
+ public:
+  Spline(std::vector<double> t, std::vector<double> q) : t_(std::move(t)), q_(std::move(q)), m_(t_.size(), 0.0) {
+    const size_t n = t_.size();
+    if (n < 3) throw std::invalid_argument("a tabulated motion needs at least 3 points");
+    for (size_t i = 1; i < n; ++i)
+      if (!(t_[i] > t_[i - 1])) throw std::invalid_argument("tabulated times must increase");
+    // Natural spline second derivatives m_i: tridiagonal system (Thomas algorithm).
+    std::vector<double> a(n, 0), b(n, 1), c(n, 0), d(n, 0);
+    for (size_t i = 1; i + 1 < n; ++i) {
+      const double h0 = t_[i] - t_[i - 1], h1 = t_[i + 1] - t_[i];
+      a[i] = h0;
+      b[i] = 2 * (h0 + h1);
+      c[i] = h1;
+      d[i] = 6 * ((q_[i + 1] - q_[i]) / h1 - (q_[i] - q_[i - 1]) / h0);
+    }
+    for (size_t i = 1; i < n; ++i) {
+      const double w = a[i] / b[i - 1];
+      b[i] -= w * c[i - 1];
+      d[i] -= w * d[i - 1];
+    }
+    m_[n - 1] = d[n - 1] / b[n - 1];
+    for (size_t i = n - 1; i-- > 0;) m_[i] = (d[i] - c[i] * m_[i + 1]) / b[i];
+  }
+  MotionSample at(double t) const override {
+    if (t < t_.front() - 1e-12 || t > t_.back() + 1e-12)
+      throw std::runtime_error("time " + std::to_string(t) + " s is outside the tabulated motion [" +
+                               std::to_string(t_.front()) + ", " + std::to_string(t_.back()) + "]");
+    size_t i = std::upper_bound(t_.begin(), t_.end(), t) - t_.begin();
+    i = std::clamp<size_t>(i, 1, t_.size() - 1);
+    const double h = t_[i] - t_[i - 1], A = (t_[i] - t) / h, B = (t - t_[i - 1]) / h;
+    MotionSample s;
+    s.q = A * q_[i - 1] + B * q_[i] + ((A * A * A - A) * m_[i - 1] + (B * B * B - B) * m_[i]) * h * h / 6;
+    s.qd = (q_[i] - q_[i - 1]) / h + ((1 - 3 * A * A) * m_[i - 1] + (3 * B * B - 1) * m_[i]) * h / 6;
+    s.qdd = A * m_[i - 1] + B * m_[i];
+    return s;
+  }
+
+ private:
+  std::vector<double> t_, q_, m_;
+};
+
+class ConstantTorque : public TorqueLaw {
+ public:
+  explicit ConstantTorque(double tau) : tau_(tau) {}
+  double at(double) const override { return tau_; }
+
+ private:
+  double tau_;
+};
+
+class LinearTorque : public TorqueLaw {
+ public:
+  LinearTorque(std::vector<double> t, std::vector<double> v) : t_(std::move(t)), v_(std::move(v)) {
+    if (t_.size() < 2) throw std::invalid_argument("a tabulated torque needs at least 2 points");
+    for (size_t i = 1; i < t_.size(); ++i)
+      if (!(t_[i] > t_[i - 1])) throw std::invalid_argument("tabulated times must increase");
+  }
+  double at(double t) const override {
+    if (t <= t_.front()) return v_.front();
+    if (t >= t_.back()) return v_.back();
+    const size_t i = std::upper_bound(t_.begin(), t_.end(), t) - t_.begin();
+    const double w = (t - t_[i - 1]) / (t_[i] - t_[i - 1]);
+    return (1 - w) * v_[i - 1] + w * v_[i];
+  }
+
+ private:
+  std::vector<double> t_, v_;
+};
+
+class FunctionTorque : public TorqueLaw {
+ public:
+  explicit FunctionTorque(std::function<double(double)> f) : f_(std::move(f)) {}
+  double at(double t) const override { return f_(t); }
+
+ private:
+  std::function<double(double)> f_;
+};
+
+}  // namespace
+
+std::shared_ptr<MotionLaw> deployment_law(double psi0, double alpha, double T) {
+  return std::make_shared<Deployment>(psi0, alpha, T);
+}
+std::shared_ptr<MotionLaw> spinup_law(double theta0, double Omega, double T) {
+  return std::make_shared<Spinup>(theta0, Omega, T);
+}
+std::shared_ptr<MotionLaw> constant_rate_law(double q0, double rate) { return std::make_shared<ConstantRate>(q0, rate); }
+std::shared_ptr<MotionLaw> tabulated_motion(std::vector<double> t, std::vector<double> q) {
+  return std::make_shared<Spline>(std::move(t), std::move(q));
+}
+std::shared_ptr<TorqueLaw> constant_torque(double tau) { return std::make_shared<ConstantTorque>(tau); }
+std::shared_ptr<TorqueLaw> tabulated_torque(std::vector<double> t, std::vector<double> tau) {
+  return std::make_shared<LinearTorque>(std::move(t), std::move(tau));
+}
+std::shared_ptr<TorqueLaw> torque_function(std::function<double(double)> f) {
+  return std::make_shared<FunctionTorque>(std::move(f));
+}
+
+void read_csv_series(const std::string& path, std::vector<double>& t, std::vector<double>& v) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open tabulated input");
+  t.clear();
+  v.clear();
+  std::string line;
+  for (int ln = 1; std::getline(in, line); ++ln) {
+    const auto hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream ss(line);
+    double a, b;
+    if (!(ss >> a >> b)) {
+      if (t.empty() && v.empty() && ln <= 2) continue;  // a header line
+      throw std::runtime_error(path + ":" + std::to_string(ln) + ": expected two numbers 'time, value'");
+    }
+    if (!std::isfinite(a) || !std::isfinite(b)) throw std::runtime_error(path + ":" + std::to_string(ln) + ": not finite");
+    t.push_back(a);
+    v.push_back(b);
+  }
+  if (t.size() < 2) throw std::runtime_error(path + ": a table needs at least two rows");
+}
+
+}  // namespace rfem

@@ -1,0 +1,58 @@
+#pragma once
+// Joint inputs: each base joint is either driven by a prescribed motion law q(t), q̇(t), q̈(t)
+// (kinematic input; its torque comes out of inverse dynamics) or by an applied torque/force τ(t)
+// (force input; its motion is unknown). Mixed freely in one run.
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/types.hpp"
+
+namespace rfem {
+
+struct MotionSample {
+  double q = 0, qd = 0, qdd = 0;
+};
+
+class MotionLaw {
+ public:
+  virtual ~MotionLaw() = default;
+  virtual MotionSample at(double t) const = 0;
+};
+
+class TorqueLaw {
+ public:
+  virtual ~TorqueLaw() = default;
+  virtual double at(double t) const = 0;
+};
+
+/// Kane's deployment law (the dimensionally consistent form, FORMULATION.md §3):
+/// ψ(t) = ψ0 − (π α/(2T)) (t − (T/2π) sin(2πt/T)) for t ≤ T, then ψ0 − π α/2.
+std::shared_ptr<MotionLaw> deployment_law(double psi0, double alpha, double T);
+/// Kane's spin-up law: θ = θ0 + (Ω/T)(t²/2 + (T/2π)²(cos(2πt/T) − 1)) for t ≤ T, then θ0 + Ω(t − T/2).
+std::shared_ptr<MotionLaw> spinup_law(double theta0, double Omega, double T);
+/// q = q0 + ω t.
+std::shared_ptr<MotionLaw> constant_rate_law(double q0, double rate);
+/// Natural cubic spline through (t_i, q_i): continuous acceleration. Constant extrapolation of the
+/// end values with zero rate outside the table is not done: t outside the table is an error.
+std::shared_ptr<MotionLaw> tabulated_motion(std::vector<double> t, std::vector<double> q);
+
+std::shared_ptr<TorqueLaw> constant_torque(double tau);
+/// Piecewise-linear interpolation of (t_i, τ_i); held constant beyond the ends.
+std::shared_ptr<TorqueLaw> tabulated_torque(std::vector<double> t, std::vector<double> tau);
+/// Any callable τ(t).
+std::shared_ptr<TorqueLaw> torque_function(std::function<double(double)> f);
+
+/// Reads a two-column CSV (time, value), '#' comments and one optional header line allowed.
+/// Throws std::runtime_error naming the file and line.
+void read_csv_series(const std::string& path, std::vector<double>& t, std::vector<double>& v);
+
+struct JointInput {
+  std::shared_ptr<MotionLaw> motion;  ///< set: kinematic input
+  std::shared_ptr<TorqueLaw> torque;  ///< set: force input (initial value and rate from q0, v0)
+  double q0 = 0.0, v0 = 0.0;
+  bool prescribed() const { return static_cast<bool>(motion); }
+};
+
+}  // namespace rfem
