@@ -10,6 +10,7 @@ namespace rfem {
 namespace {
 
 constexpr int kChunk = 64;  // rfes per reduction chunk (fixed: thread-count independent sums)
+int g_parallel_min = 256;  // below this many rfes a parallel region costs more than it saves
 
 struct BaseMoments {  // Σ over bodies of Y = W H Ẅᵀ, G = W H Wᵀ, s = W H e₄
   Mat4 Y = Mat4::Zero(), G = Mat4::Zero();
@@ -51,21 +52,25 @@ void base_kin(const Model& model, const VecX& q, const VecX& v, const VecX& a, B
 
 }  // namespace
 
+void set_parallel_min_rfes(int n) { g_parallel_min = n; }
+
 void generalised_forces(const Model& model, const VecX& q, const VecX& v, const VecX& a,
                         const ForceTerms& terms, VecX& F) {
   const int n = model.n(), m = model.m();
   const Discretisation& d = model.link;
   const double g = terms.gravity ? model.gravity : 0.0;
   F.setZero(model.dof());
+  const VecX zero_v = terms.velocity_products ? VecX() : VecX::Zero(model.dof());
+  const VecX& vi = terms.velocity_products ? v : zero_v;  // velocity seen by the inertial terms
   BaseKinematics bk;
-  base_kin(model, q, v, a, bk);
+  base_kin(model, q, vi, a, bk);
   const int nchunks = (n + kChunk - 1) / kChunk;
   std::vector<BaseMoments> chunk(nchunks);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= g_parallel_min)
   for (int c = 0; c < nchunks; ++c) {
     RfePose pose;
     for (int k = c * kChunk; k < std::min(n, (c + 1) * kChunk); ++k) {
-      rfe_pose(d.rfes[k], bk, rfe_coords(q, k), rfe_coords(v, k), rfe_coords(a, k), pose);
+      rfe_pose(d.rfes[k], bk, rfe_coords(q, k), rfe_coords(vi, k), rfe_coords(a, k), pose);
       Vec6 f = Vec6::Zero(), fg;
       Mat4 Y;
       Vec4 s;
@@ -81,7 +86,7 @@ void generalised_forces(const Model& model, const VecX& q, const VecX& v, const 
   if (terms.sde) {
     const double beta = d.damping_beta;
     for (int colour = 0; colour < 2; ++colour) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= g_parallel_min)
       for (int e = colour; e < n; e += 2) {
         const Sde& s = d.sdes[e];
         const Vec6 ql = left_coords(q, e), vl = left_coords(v, e);
@@ -113,7 +118,7 @@ void assemble_matrix(const Model& model, const BorderedPattern& pattern, const s
   const double g = t.gravity ? model.gravity : 0.0;
   const int nchunks = (n + kChunk - 1) / kChunk;
   std::vector<BaseMoments> chunk(nchunks);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= g_parallel_min)
   for (int c = 0; c < nchunks; ++c) {
     RfePose pose;
     Mat6 Mkk;
@@ -141,7 +146,7 @@ void assemble_matrix(const Model& model, const BorderedPattern& pattern, const s
     }
   }
   for (int colour = 0; colour < 2; ++colour) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= g_parallel_min)
     for (int e = colour; e < n; e += 2) {
       const Sde& s = d.sdes[e];
       Mat12 S = Mat12::Zero();
@@ -196,7 +201,7 @@ Energies energies(const Model& model, const VecX& q, const VecX& v) {
     E.gravity += model.gravity * (bk.W[i] * H.col(3))[2];
   }
   double T = 0.0, Vg = 0.0, Ve = 0.0, Pd = 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : T, Vg, Ve, Pd)
+#pragma omp parallel for schedule(static) reduction(+ : T, Vg, Ve, Pd) if (n >= g_parallel_min)
   for (int k = 0; k < n; ++k) {
     RfePose pose;
     rfe_pose(d.rfes[k], bk, rfe_coords(q, k), rfe_coords(v, k), rfe_coords(zero, k), pose);

@@ -8,10 +8,17 @@
 
 namespace rfem {
 
+/// Smallest number of rfes for which assembly runs in parallel (default 256; tests set 1 to
+/// exercise the parallel paths on small models).
+void set_parallel_min_rfes(int n);
+
 /// Which generalised forces to include (inputs τ are never included: the caller adds them).
 struct ForceTerms {
   bool inertia = true, gravity = true;
   bool sde = true;  ///< elastic and damping forces of the sdes
+  /// Velocity-product (Coriolis, centrifugal) terms h of the inertial force. Off only to show what
+  /// a model without them gets wrong (tests): then ε = M(q) a.
+  bool velocity_products = true;
 };
 
 /// F = ε(q, v, a) + ∂V_g/∂q + ∂V_e/∂q + sde damping for all 6n + m coordinates (flexible first).

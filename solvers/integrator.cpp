@@ -9,7 +9,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include "solvers/cholmod_solver.hpp"
+#include "solvers/newton_system.hpp"
 
 namespace rfem {
 
@@ -20,17 +20,16 @@ struct Problem {
   const Model& model;
   const std::vector<JointInput>& inputs;
   const std::atomic<int>* stop;
+  ForceTerms terms;
   std::vector<int> unknown;   ///< full index of each unknown coordinate
-  std::vector<int> base_col;  ///< joint → pattern column, −1 if prescribed
-  BorderedPattern pattern;
-  CholmodSolver solver;
-  std::vector<double> S, K;   ///< Newton matrix and its stiffness part
+  std::vector<int> base_col;  ///< joint → column among the unknowns, −1 if prescribed
+  std::unique_ptr<NewtonSystem> newton, output_solver;
   double cj_factor = 0.0;
   VecX q, v, a, F;            ///< full-coordinate scratch
   bool damped;
 
-  Problem(const Model& m, const std::vector<JointInput>& in, const std::atomic<int>* s, int nb)
-      : model(m), inputs(in), stop(s), pattern(m.n(), nb), solver(pattern), damped(m.link.damping_beta > 0) {}
+  Problem(const Model& m, const std::vector<JointInput>& in, const std::atomic<int>* s)
+      : model(m), inputs(in), stop(s), damped(m.link.damping_beta > 0) {}
   int nu() const { return static_cast<int>(unknown.size()); }
 
   // Full q, v, a at time t from the unknowns' values and the laws of prescribed joints.
@@ -73,7 +72,7 @@ int residual(sunrealtype t, N_Vector yv, N_Vector ypv, N_Vector rv, void* data) 
   } catch (const std::exception&) {
     return -1;
   }
-  generalised_forces(p.model, p.q, p.v, p.a, ForceTerms{}, p.F);
+  generalised_forces(p.model, p.q, p.v, p.a, p.terms, p.F);
   const VecX tau = p.torques(t);
   const int n6 = 6 * p.model.n();
   for (int i = 0; i < u; ++i) {
@@ -94,49 +93,19 @@ int jacobian(sunrealtype t, sunrealtype cj, N_Vector yv, N_Vector, N_Vector, SUN
              N_Vector, N_Vector) {
   auto& p = *static_cast<Problem*>(data);
   p.expand(t, N_VGetArrayPointer(yv), nullptr);
-  MatrixTerms terms;
-  terms.mass = cj * cj;
-  terms.damping = cj;
-  terms.stiffness = 1.0;
-  assemble_matrix(p.model, p.pattern, p.base_col, p.q, p.v, terms, p.S);
-  MatrixTerms kt;
-  kt.stiffness = 1.0;
-  assemble_matrix(p.model, p.pattern, p.base_col, p.q, p.v, kt, p.K);
   p.cj_factor = cj;
-  return p.solver.factorize(p.S) ? 0 : 1;
+  return p.newton->setup(p.q, p.v, cj) ? 0 : 1;
 }
 
-// y = K x for the symmetric pattern (upper triangle stored).
-void stiffness_times(const Problem& p, const double* x, double* y) {
-  const auto& cp = p.pattern.colptr();
-  const auto& ri = p.pattern.rowind();
-  const int N = p.pattern.size();
-  std::fill(y, y + N, 0.0);
-  for (int c = 0; c < N; ++c)
-    for (long k = cp[c]; k < cp[c + 1]; ++k) {
-      const long r = ri[k];
-      y[r] += p.K[k] * x[c];
-      if (r != c) y[c] += p.K[k] * x[r];
-    }
-}
-
-// Solve [c I, −I; K, C + c M] [x1; x2] = [b1; b2]: (c² M + c C + K) x2 = c b2 − K b1, x1 = (b1 + x2)/c.
 int ls_solve(SUNLinearSolver ls, SUNMatrix, N_Vector xv, N_Vector bv, sunrealtype) {
   auto& p = *static_cast<Problem*>(ls->content);
   const double* b = N_VGetArrayPointer(bv);
   double* x = N_VGetArrayPointer(xv);
   const int u = p.nu();
-  const double c = p.cj_factor;
-  VecX Kb1(u), rhs(u);
-  stiffness_times(p, b, Kb1.data());
-  for (int i = 0; i < u; ++i) rhs[i] = c * b[u + i] - Kb1[i];
-  p.solver.solve(rhs);
-  for (int i = 0; i < u; ++i) {
-    x[u + i] = rhs[i];
-    x[i] = (b[i] + rhs[i]) / c;
-  }
-  x[2 * u] = b[2 * u] / c;  // energy integrals: their coupling to y is left out (modified Newton)
-  x[2 * u + 1] = b[2 * u + 1] / c;
+  p.newton->solve(b, x);
+  // Energy integrals: their coupling to y is left out (a modified Newton step for them).
+  x[2 * u] = b[2 * u] / p.cj_factor;
+  x[2 * u + 1] = b[2 * u + 1] / p.cj_factor;
   return 0;
 }
 
@@ -172,9 +141,31 @@ void check(int flag, const char* what) {
   if (flag < 0) throw std::runtime_error(std::string(what) + " failed: " + IDAGetReturnFlagName(flag));
 }
 
-OutputSample sample(Problem& p, double t, const double* y, const double* yp) {
-  p.expand(t, y, yp);
-  generalised_forces(p.model, p.q, p.v, p.a, ForceTerms{}, p.F);
+// Accelerations of the unknowns from the equations of motion at state y:
+// M_uu a_u = τ_u − F(q, v, a with a_u = 0). More accurate than IDA's interpolated y' (BDF2's
+// derivative is first order), and what inverse dynamics needs for the required torques.
+VecX consistent_accelerations(Problem& p, double t, const double* y) {
+  const int u = p.nu(), n6 = 6 * p.model.n();
+  p.expand(t, y, nullptr);
+  generalised_forces(p.model, p.q, p.v, p.a, p.terms, p.F);
+  const VecX tau = p.torques(t);
+  VecX rhs(u);
+  for (int i = 0; i < u; ++i) {
+    const int k = p.unknown[i];
+    rhs[i] = (k >= n6 ? tau[k - n6] : 0.0) - p.F[k];
+  }
+  if (!p.output_solver->setup_mass(p.q, p.v))
+    throw std::runtime_error("the mass matrix is not positive definite at t = " + std::to_string(t));
+  p.output_solver->solve_mass(rhs);
+  return rhs;
+}
+
+OutputSample sample(Problem& p, double t, const double* y) {
+  const int u = p.nu();
+  VecX yp = VecX::Zero(2 * u + 2);
+  if (u > 0) yp.segment(u, u) = consistent_accelerations(p, t, y);
+  p.expand(t, y, yp.data());
+  generalised_forces(p.model, p.q, p.v, p.a, p.terms, p.F);
   OutputSample s;
   s.t = t;
   s.q = p.q;
@@ -182,7 +173,6 @@ OutputSample sample(Problem& p, double t, const double* y, const double* yp) {
   s.a = p.a;
   s.tau = p.torques(t);
   s.energy = energies(p.model, p.q, p.v);
-  const int u = p.nu();
   s.dissipated = y[2 * u];
   s.input_work = y[2 * u + 1];
   return s;
@@ -196,7 +186,8 @@ RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, 
     throw std::invalid_argument("one input per joint is required");
   int nb = 0;
   for (const auto& in : inputs) nb += in.prescribed() ? 0 : 1;
-  Problem p(model, inputs, stop, nb);
+  Problem p(model, inputs, stop);
+  p.terms = opts.forces;
   const int n6 = 6 * model.n();
   for (int i = 0; i < n6; ++i) p.unknown.push_back(i);
   p.base_col.assign(model.m(), -1);
@@ -205,6 +196,8 @@ RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, 
       p.base_col[j] = static_cast<int>(p.unknown.size());
       p.unknown.push_back(n6 + j);
     }
+  p.newton = std::make_unique<NewtonSystem>(model, p.base_col, nb);
+  p.output_solver = std::make_unique<NewtonSystem>(model, p.base_col, nb);  // keeps IDA's factor intact
   const int u = p.nu(), N = 2 * u + 2;
   const long n_out = std::lround(std::ceil(opts.t_end / opts.output_dt - 1e-9));
   RunOutcome out;
@@ -217,24 +210,11 @@ RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, 
       y0[u + p.base_col[j]] = inputs[j].v0;
     }
   if (u > 0) {
-    // Consistent accelerations: M_uu a_u = τ_u − F(q, v, a with a_u = 0).
-    p.expand(0.0, y0.data(), yp0.data());
-    generalised_forces(model, p.q, p.v, p.a, ForceTerms{}, p.F);
-    const VecX tau = p.torques(0.0);
-    VecX rhs(u);
-    for (int i = 0; i < u; ++i) {
-      const int k = p.unknown[i];
-      rhs[i] = (k >= n6 ? tau[k - n6] : 0.0) - p.F[k];
-    }
-    MatrixTerms mt;
-    mt.mass = 1.0;
-    assemble_matrix(model, p.pattern, p.base_col, p.q, p.v, mt, p.S);
-    if (!p.solver.factorize(p.S)) throw std::runtime_error("the mass matrix is not positive definite at t = 0");
-    p.solver.solve(rhs);
+    const VecX a0 = consistent_accelerations(p, 0.0, y0.data());
     yp0.head(u) = y0.segment(u, u);
-    yp0.segment(u, u) = rhs;
+    yp0.segment(u, u) = a0;
     p.expand(0.0, y0.data(), yp0.data());
-    generalised_forces(model, p.q, p.v, p.a, ForceTerms{}, p.F);
+    generalised_forces(model, p.q, p.v, p.a, p.terms, p.F);
     yp0[2 * u] = p.damped ? energies(model, p.q, p.v).dissipation_rate : 0.0;
     yp0[2 * u + 1] = p.input_power(p.torques(0.0));
   }
@@ -246,7 +226,7 @@ RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, 
         out.status = "interrupted (signal " + std::to_string(stop->load()) + ")";
         return out;
       }
-      OutputSample s = sample(p, t, y0.data(), yp0.data());
+      OutputSample s = sample(p, t, y0.data());
       const double P = p.input_power(s.tau);
       W += 0.5 * (P + last_P) * (t - last_t);  // ∫ τ·q̇ dt, trapezoidal between outputs
       s.input_work = W;
@@ -259,7 +239,7 @@ RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, 
     out.status = "completed";
     return out;
   }
-  sink(sample(p, 0.0, y0.data(), yp0.data()));
+  sink(sample(p, 0.0, y0.data()));
 
   IdaHandles h;
   check(SUNContext_Create(nullptr, &h.ctx), "SUNContext_Create");
@@ -283,6 +263,7 @@ RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, 
   check(IDASetMaxNumSteps(h.ida, opts.max_steps), "IDASetMaxNumSteps");
   if (opts.max_step > 0) check(IDASetMaxStep(h.ida, opts.max_step), "IDASetMaxStep");
   check(IDASetMaxOrd(h.ida, opts.max_order), "IDASetMaxOrd");
+  check(IDASetStopTime(h.ida, opts.t_end), "IDASetStopTime");  // tabulated inputs end at t_end
   h.A = SUNMatNewEmpty(h.ctx);
   h.A->ops->getid = mat_id;
   h.A->ops->zero = mat_zero;
@@ -322,7 +303,7 @@ RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, 
                    " s); try looser tolerances, a smaller max_step, or check the inputs";
       return out;
     }
-    sink(sample(p, tret, N_VGetArrayPointer(h.y), N_VGetArrayPointer(h.yp)));
+    sink(sample(p, tret, N_VGetArrayPointer(h.y)));
     out.t_reached = tret;
   }
   out.completed = true;

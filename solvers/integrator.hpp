@@ -29,6 +29,7 @@ struct IntegratorOptions {
   /// Highest BDF order. BDF orders above 2 are not A-stable: the undamped axial and shear sde
   /// modes (ω ~ 1e3–1e5 rad/s) would force tiny steps. BDF2 steps over them.
   int max_order = 2;
+  ForceTerms forces;  ///< all on for physics; tests switch velocity products off
 };
 
 /// One output step: full coordinates, the torque of every joint (applied or required) and energies.

@@ -29,6 +29,7 @@ std::vector<double> newton_values(const Model& m, const BorderedPattern& p, cons
 }  // namespace
 
 TEST(Assembly, SparseEqualsDenseReferenceWithOneAndTwoThreads) {
+  set_parallel_min_rfes(1);  // exercise the parallel paths on a small model
   const Model m = test::spatial_arm(7, 0.002);
   VecX q, v, a;
   test::random_state(m, 11, q, v, a);
