@@ -126,6 +126,7 @@ RunSummary run_one(ResultsFile& file, const std::string& name, const Model& mode
   o.atol_velocity = cs.sim.atol_velocity;
   o.max_step = cs.sim.max_step;
   o.max_order = cs.sim.max_order;
+  o.max_steps = cs.sim.max_steps;
   double balance0 = NAN;
   const auto t0 = std::chrono::steady_clock::now();
   const RunOutcome r = integrate(

@@ -323,7 +323,8 @@ InputSpec read_input(const Reader& r, const toml::table& t, const std::string& p
 
 Simulation read_simulation(const Reader& r, const toml::table& t) {
   const std::string p = "simulation";
-  r.check_keys(t, p, {"t_end", "output_dt", "rtol", "atol", "atol_velocity", "max_step", "procedure", "store_flexible_every", "max_order"});
+  r.check_keys(t, p, {"t_end", "output_dt", "rtol", "atol", "atol_velocity", "max_step", "procedure", "store_flexible_every", "max_order",
+                    "max_steps"});
   Simulation s;
   s.t_end = r.positive(t, p, "t_end");
   s.output_dt = r.positive(t, p, "output_dt", std::min(0.01, s.t_end));
@@ -337,6 +338,7 @@ Simulation read_simulation(const Reader& r, const toml::table& t) {
     r.fail(t.get("procedure"), p + ".procedure", "must be \"single\" or \"paper\" (got \"" + s.procedure + "\")");
   s.flexible_every = static_cast<int>(r.integer(t, p, "store_flexible_every", 0, 0));
   s.max_order = static_cast<int>(r.integer(t, p, "max_order", 2, 1));
+  s.max_steps = r.integer(t, p, "max_steps", 20000, 1);
   if (s.max_order > 5) r.fail(t.get("max_order"), p + ".max_order", "must be between 1 and 5");
   return s;
 }

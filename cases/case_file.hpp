@@ -34,6 +34,7 @@ struct Simulation {
   std::string procedure = "single";  ///< single | paper (rigid inverse dynamics, kinematic, force input)
   int flexible_every = 0;            ///< store the full flexible state every k outputs (0: never)
   int max_order = 2;                 ///< highest BDF order (2: A-stable over undamped stiff sde modes)
+  long max_steps = 20000;            ///< IDA steps allowed per output interval
 };
 
 struct Case {

@@ -6,6 +6,7 @@
 #include <sundials/sundials_matrix.h>
 
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <stdexcept>
 
@@ -260,6 +261,8 @@ RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, 
   N_VDestroy(abstol);
   check(tol_flag, "IDASVtolerances");
   check(IDASetUserData(h.ida, &p), "IDASetUserData");
+  // IDA's own messages are silenced: failures are reported once, with advice, in RunOutcome.
+  check(IDASetErrHandlerFn(h.ida, [](int, const char*, const char*, char*, void*) {}, nullptr), "IDASetErrHandlerFn");
   check(IDASetMaxNumSteps(h.ida, opts.max_steps), "IDASetMaxNumSteps");
   if (opts.max_step > 0) check(IDASetMaxStep(h.ida, opts.max_step), "IDASetMaxStep");
   check(IDASetMaxOrd(h.ida, opts.max_order), "IDASetMaxOrd");
@@ -298,9 +301,10 @@ RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, 
     if (flag < 0) {
       double tcur = 0.0;
       IDAGetCurrentTime(h.ida, &tcur);
-      out.status = std::string("failed: IDA ") + IDAGetReturnFlagName(flag) + " at t = " + std::to_string(tcur) +
-                   " s (last step " + std::to_string(out.stats.last_step) +
-                   " s); try looser tolerances, a smaller max_step, or check the inputs";
+      char buf[160];
+      std::snprintf(buf, sizeof buf, " at t = %.6g s (last step %.3g s)", tcur, out.stats.last_step);
+      out.status = std::string("failed: IDA ") + IDAGetReturnFlagName(flag) + buf +
+                   "; try looser tolerances, a smaller max_step, or check the inputs";
       return out;
     }
     sink(sample(p, tret, N_VGetArrayPointer(h.y)));

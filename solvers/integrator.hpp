@@ -25,7 +25,7 @@ struct IntegratorOptions {
   double atol_velocity = 1e-5;
   double atol_energy = 1e-6;     ///< on the dissipated-energy and input-work integrals [J]
   double max_step = 0.0;    ///< 0: IDA's default (no limit)
-  long max_steps = 1000000; ///< internal steps per output interval
+  long max_steps = 20000;   ///< internal steps per output interval before giving up
   /// Highest BDF order. BDF orders above 2 are not A-stable: the undamped axial and shear sde
   /// modes (ω ~ 1e3–1e5 rad/s) would force tiny steps. BDF2 steps over them.
   int max_order = 2;
