@@ -16,6 +16,8 @@ struct Common {
   std::vector<std::string> overrides;  ///< --set key.path=value
   int n = 0;                           ///< --n (0: the case's discretisation)
   bool json = false;
+  bool quiet = false;    ///< no progress line and no summary (results only)
+  bool verbose = false;  ///< log solver events
   int threads = 0;
 };
 
@@ -30,7 +32,10 @@ int run_static(const Common& c);
 int run_modes(const Common& c, const ModesOptions& o);
 /// `rfem run`: time integration of the case's [simulation], results to an HDF5 file.
 int run_simulation(const Common& c, const std::string& output);
-int run_refine(const Common& c, const std::vector<int>& ns, const std::string& quantity, const ModesOptions& o);
+/// `rfem refine`: a quantity over a series of n, with observed order and Richardson extrapolation;
+/// dynamic quantities (and --output) write every run and the table to one HDF5 file.
+int run_refine(const Common& c, const std::vector<int>& ns, const std::string& quantity, const ModesOptions& o,
+               const std::string& output);
 
 /// Joint values and rates of the case, with --rate applied.
 void joint_state(const Case& cs, const ModesOptions& o, VecX& qb, VecX& vb);
@@ -38,5 +43,8 @@ void joint_state(const Case& cs, const ModesOptions& o, VecX& qb, VecX& vb);
 double evaluate_quantity(const Case& cs, int n, const std::string& quantity, const ModesOptions& o);
 
 void print_json(const nlohmann::json& j);
+
+/// `rfem plot RESULTS.h5 [-o DIR]`: PNG figures of a results or refinement file.
+int run_plot(const std::string& results, const std::string& outdir);
 
 }  // namespace rfem::app

@@ -45,7 +45,10 @@ Eigen::Vector3d tip_deflection(const Model& model, const VecX& q) {
 
 RunGroup::RunGroup(ResultsFile& file, const std::string& name, const Model& model, int flexible_every)
     : file_(file), model_(model), flexible_every_(flexible_every), last_flush_(std::chrono::steady_clock::now()) {
-  group_ = H5Gcreate2(file.id(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  const hid_t lcpl = H5Pcreate(H5P_LINK_CREATE);  // "n60/kinematic" creates "n60" as needed
+  H5Pset_create_intermediate_group(lcpl, 1);
+  group_ = H5Gcreate2(file.id(), name.c_str(), lcpl, H5P_DEFAULT, H5P_DEFAULT);
+  H5Pclose(lcpl);
   if (group_ < 0) throw std::runtime_error(file.path() + ": cannot create group " + name);
   const int m = model.m();
   std::string joints;

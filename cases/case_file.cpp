@@ -14,6 +14,8 @@ namespace rfem {
 
 namespace {
 
+constexpr long kMaxRfes = 10000000;  // far beyond memory; guards int overflow of n and parts
+
 // Reads typed values from a toml table with the file, line and dotted key in every error.
 class Reader {
  public:
@@ -73,12 +75,14 @@ class Reader {
     return v;
   }
 
-  long integer(const toml::table& t, const std::string& path, const std::string& key, long dflt, long min) const {
+  long integer(const toml::table& t, const std::string& path, const std::string& key, long dflt, long min,
+               long max) const {
     const toml::node* n = t.get(key);
     if (!n) return dflt;
     auto i = n->as_integer();
     if (!i) fail(n, join(path, key), std::string("must be an integer, not ") + type_name(*n));
     if (i->get() < min) fail(n, join(path, key), "must be at least " + std::to_string(min) + " (got " + std::to_string(i->get()) + ")");
+    if (i->get() > max) fail(n, join(path, key), "must be at most " + std::to_string(max) + " (got " + std::to_string(i->get()) + ")");
     return static_cast<long>(i->get());
   }
 
@@ -313,7 +317,7 @@ InputSpec read_input(const Reader& r, const toml::table& t, const std::string& p
     r.check_keys(t, path, {"kind", "file", "run", "joint"});
     file_key();
     in.run = r.string(t, path, "run");
-    in.joint = static_cast<int>(r.integer(t, path, "joint", 0, 1));
+    in.joint = static_cast<int>(r.integer(t, path, "joint", 0, 1, 1000));
   } else {
     r.fail(t.get("kind"), path + ".kind",
            "unknown input '" + in.kind + "' (deployment, spinup, constant_rate, table, torque, torque_table, torque_from_run)");
@@ -336,10 +340,9 @@ Simulation read_simulation(const Reader& r, const toml::table& t) {
   s.procedure = r.string(t, p, "procedure", std::string("single"));
   if (s.procedure != "single" && s.procedure != "paper")
     r.fail(t.get("procedure"), p + ".procedure", "must be \"single\" or \"paper\" (got \"" + s.procedure + "\")");
-  s.flexible_every = static_cast<int>(r.integer(t, p, "store_flexible_every", 0, 0));
-  s.max_order = static_cast<int>(r.integer(t, p, "max_order", 2, 1));
-  s.max_steps = r.integer(t, p, "max_steps", 20000, 1);
-  if (s.max_order > 5) r.fail(t.get("max_order"), p + ".max_order", "must be between 1 and 5");
+  s.flexible_every = static_cast<int>(r.integer(t, p, "store_flexible_every", 0, 0, 1000000000));
+  s.max_order = static_cast<int>(r.integer(t, p, "max_order", 2, 1, 5));
+  s.max_steps = r.integer(t, p, "max_steps", 20000, 1, 1000000000);
   return s;
 }
 
@@ -381,7 +384,7 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
     const toml::table& lt = *ln->as_table();
     r.check_keys(lt, "link", {"n", "damping_beta", "mount", "segments"});
     c.has_link = true;
-    c.n = static_cast<int>(r.integer(lt, "link", "n", 0, 1));
+    c.n = static_cast<int>(r.integer(lt, "link", "n", 0, 1, kMaxRfes));
     c.link.damping_beta = r.non_negative(lt, "link", "damping_beta", 0.0);
     if (const toml::node* mn = lt.get("mount")) {
       if (!mn->is_table()) r.fail(mn, "link.mount", "must be a table {xyz, rpy}");
@@ -404,7 +407,7 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
       s.material = mats.at(mn);
       s.section = secs.at(sc);
       if (!st.get("parts") && c.n == 0) r.fail(&st, p + ".parts", "missing (give parts per segment or link.n)");
-      s.parts = static_cast<int>(r.integer(st, p, "parts", 1, 1));
+      s.parts = static_cast<int>(r.integer(st, p, "parts", 1, 1, kMaxRfes));
       c.link.segments.push_back(s);
     }
     if (c.n > 0 && c.n < static_cast<int>(c.link.segments.size()))
@@ -438,6 +441,11 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
         j.H = read_body(r, *bn->as_table(), p + ".body", mats, secs);
       }
       InputSpec in;
+      {
+        std::ostringstream where;
+        where << path << ":" << jt.source().begin.line << ": " << p << ".input";
+        in.where = where.str();
+      }
       if (const toml::node* inn = jt.get("input")) {
         if (!inn->is_table()) r.fail(inn, p + ".input", "must be a table {kind = …}");
         in = read_input(r, *inn->as_table(), p + ".input", case_dir);
@@ -457,6 +465,10 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
     if (!sn->is_table()) r.fail(sn, "simulation", "must be a table");
     c.sim = read_simulation(r, *sn->as_table());
     c.has_simulation = true;
+    if (c.sim.procedure == "paper")
+      for (const InputSpec& in : c.inputs)
+        if (!in.prescribed())
+          throw CaseError(in.where + ": the paper procedure needs a motion law on every joint (got '" + in.kind + "')");
   }
   if (const toml::node* ln = root.get("loads")) {
     if (!ln->is_table()) r.fail(ln, "loads", "must be a table");

@@ -307,7 +307,10 @@ RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, 
                    "; try looser tolerances, a smaller max_step, or check the inputs";
       return out;
     }
-    sink(sample(p, tret, N_VGetArrayPointer(h.y)));
+    OutputSample smp = sample(p, tret, N_VGetArrayPointer(h.y));
+    smp.steps = out.stats.steps;
+    smp.last_step = out.stats.last_step;
+    sink(smp);
     out.t_reached = tret;
   }
   out.completed = true;

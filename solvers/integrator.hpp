@@ -39,6 +39,8 @@ struct OutputSample {
   VecX tau;       ///< joint torques/forces [N m or N], applied (force input) or required (kinematic)
   Energies energy;
   double dissipated = 0.0, input_work = 0.0;  ///< integrals since t = 0 [J]
+  long steps = 0;        ///< IDA steps taken so far (for progress reports)
+  double last_step = 0;  ///< IDA's last step size [s]
 };
 
 struct IntegratorStats {

@@ -6,7 +6,7 @@
 
 namespace rfem::test {
 
-std::string source_path(const std::string& rel) { return std::string(RFEM_SOURCE_DIR) + "/" + rel; }
+std::string source_path(const std::string& rel) { return std::string(TEST_SOURCE_DIR) + "/" + rel; }
 
 Model spatial_arm(int n, double beta) {
   Material al{"al", 7e10, 2.7e10, 2700};

@@ -1,0 +1,35 @@
+#pragma once
+// Running a case's [simulation]: its joint inputs, the single or paper procedure, one HDF5 group
+// per run with its summary. Shared by `rfem run` and dynamic quantities of `rfem refine`.
+#include <atomic>
+#include <functional>
+
+#include "apps/commands.hpp"
+#include "apps/results_file.hpp"
+
+namespace rfem::app {
+
+struct RunSummary {
+  std::string name, status;
+  bool completed = false;
+  double wall = 0, t_reached = 0, peak_u1 = 0, peak_u2 = 0, peak_theta = 0, energy_drift = 0, energy_scale = 0;
+  IntegratorStats stats;
+  long samples = 0;
+};
+
+/// Called at every output step of every run, with the run's group name (prefix included).
+using Observer = std::function<void(const std::string& run, const Model& model, const OutputSample& s)>;
+
+/// The joints' inputs of a case (reads tabulated files and earlier results; CaseError if bad).
+std::vector<JointInput> joint_inputs(const Case& cs);
+
+/// Runs the case's procedure on `model`, writing groups `prefix + run name` into `file`.
+std::vector<RunSummary> simulate_case(const Case& cs, const Model& model, const std::vector<JointInput>& inputs,
+                                      ResultsFile& file, const std::string& prefix, bool quiet,
+                                      const Observer& observe = {});
+
+/// SIGINT/SIGTERM set the stop flag: runs end cleanly after the current step.
+void install_signal_handlers();
+std::atomic<int>& stop_flag();
+
+}  // namespace rfem::app

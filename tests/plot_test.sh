@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# rfem plot writes every expected PNG for the paper's case, and none is blank (pixel spread).
+set -euo pipefail
+rfem=$1
+src=$(cd "$(dirname "$0")/.." && pwd)
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+cd "$dir"
+"$rfem" run "$src/cases/paper_deployment.toml" --quiet --set simulation.t_end=4 -o paper.h5
+"$rfem" plot paper.h5 -o figs >/dev/null
+/usr/bin/python3 - figs <<'PY'
+import sys, os
+import matplotlib.image as mpimg
+d = sys.argv[1]
+expected = ["fig5_tip", "fig6_torque3", "fig7_velocity3", "fig8_accel12"] + \
+    [f"{g}_{k}" for g in ("rigid", "kinematic", "force") for k in ("joints", "tip", "energy")]
+bad = 0
+for name in expected:
+    path = os.path.join(d, name + ".png")
+    if not os.path.exists(path):
+        print("FAIL missing", path); bad += 1; continue
+    img = mpimg.imread(path)
+    if img.std() < 0.02:
+        print("FAIL blank", path); bad += 1
+    else:
+        print("ok", name)
+print(f"{len(expected) - bad} passed, {bad} failed")
+sys.exit(1 if bad else 0)
+PY
+# An unreadable results file: one-line error, exit 2.
+echo "not hdf5" > bad.h5
+if "$rfem" plot bad.h5 2>err.txt; then echo "FAIL: plot accepted a non-HDF5 file"; exit 1; fi
+grep -q "rfem plot: error: bad.h5" err.txt || { echo "FAIL: message"; cat err.txt; exit 1; }
