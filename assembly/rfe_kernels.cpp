@@ -20,7 +20,10 @@ void rfe_pose(const Rfe& rfe, const BaseKinematics& bk, const Vec6& q, const Vec
 
 void rfe_inertial_force(const Rfe& rfe, const RfePose& p, Vec6& eps, Mat4& Y) {
   const Mat34 F = p.R0.transpose() * p.Wdd;  // Ẅ seen in {r} axes
-  for (int j = 0; j < 6; ++j) eps[j] = trace_AHBt(p.d.dD[j], rfe.H, F);
+  // H = [J 0; 0 m] about the mass centre: ∂D/∂x_j H = m e_j e₄ᵀ, ∂D/∂φ_a H = [∂R/∂φ_a J, 0].
+  const Mat3 J = rfe.H.topLeftCorner<3, 3>();
+  for (int j = 0; j < 3; ++j) eps[j] = rfe.mass * F(j, 3);
+  for (int a = 0; a < 3; ++a) eps[3 + a] = ((p.d.dR[a] * J).array() * F.leftCols<3>().array()).sum();
   Mat4 Wdd4 = Mat4::Zero();
   Wdd4.topRows<3>() = p.Wdd;
   Y = p.W * rfe.H * Wdd4.transpose();

@@ -10,11 +10,12 @@ struct SdeGeometry {
   DeformationTransform dl, dp;
 };
 
-void geometry(const Sde& e, const Vec3& cl, const Vec3& cr, const Vec6& ql, const Vec6& qp,
-              SdeGeometry& g) {
+// `second`: also ∂²R/∂φ² (the geometric stiffness needs it, the forces do not).
+void geometry(const Sde& e, const Vec3& cl, const Vec3& cr, const Vec6& ql, const Vec6& qp, SdeGeometry& g,
+              bool second) {
   const bool has_left = e.left >= 0;
-  deformation_transform(has_left ? ql : Vec6::Zero().eval(), g.dl);
-  deformation_transform(qp, g.dp);
+  deformation_transform(has_left ? ql : Vec6::Zero().eval(), g.dl, second);
+  deformation_transform(qp, g.dp, second);
   const Vec3 pl = cl + g.dl.D.topLeftCorner<3, 3>() * e.eta_left + g.dl.D.topRightCorner<3, 1>();
   const Vec3 pr = cr + g.dp.D.topLeftCorner<3, 3>() * e.eta_right + g.dp.D.topRightCorner<3, 1>();
   g.dx = pr - pl;
@@ -33,7 +34,7 @@ void geometry(const Sde& e, const Vec3& cl, const Vec3& cr, const Vec6& ql, cons
 void sde_forces(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const Vec6& ql,
                 const Vec6& vl, const Vec6& qp, const Vec6& vp, SdeResult& out) {
   SdeGeometry g;
-  geometry(e, cl, cr, ql, qp, g);
+  geometry(e, cl, cr, ql, qp, g, false);
   const bool has_left = e.left >= 0;
   const Vec3 dphi = qp.tail<3>() - (has_left ? ql.tail<3>() : Vec3::Zero().eval());
   Vec12 qdot;
@@ -53,7 +54,7 @@ void sde_forces(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const
 void sde_matrix(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const Vec6& ql,
                 const Vec6& qp, double ck, double cd, Mat12& S) {
   SdeGeometry g;
-  geometry(e, cl, cr, ql, qp, g);
+  geometry(e, cl, cr, ql, qp, g, true);
   Mat12 base = g.J.transpose() * e.c.asDiagonal() * g.J;  // Jᵀ c J
   for (int a = 0; a < 3; ++a) {
     base(3 + a, 3 + a) += e.k[a];

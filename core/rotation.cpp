@@ -25,61 +25,61 @@ Mat3 rot_z(double a) {
 Mat3 rot_rpy(const Vec3& rpy) { return rot_z(rpy[2]) * rot_y(rpy[1]) * rot_x(rpy[0]); }
 
 namespace {
-// Generator of rotations about axis a: ∂Rot_a(φ)/∂φ = Rot_a(φ) G_a.
-Mat3 generator(int a) {
-  Mat3 G = Mat3::Zero();
-  const int b = (a + 1) % 3, c = (a + 2) % 3;
-  G(c, b) = 1.0;
-  G(b, c) = -1.0;
-  return G;
-}
+// First and second derivatives of the elementary rotations, written out (no generator products).
+Mat3 d_rot_x(double c, double s) { Mat3 R; R << 0, 0, 0, 0, -s, -c, 0, c, -s; return R; }
+Mat3 d_rot_y(double c, double s) { Mat3 R; R << -s, 0, c, 0, 0, 0, -c, 0, -s; return R; }
+Mat3 d_rot_z(double c, double s) { Mat3 R; R << -s, -c, 0, c, -s, 0, 0, 0, 0; return R; }
+Mat3 dd_rot_x(double c, double s) { Mat3 R; R << 0, 0, 0, 0, -c, s, 0, -s, -c; return R; }
+Mat3 dd_rot_y(double c, double s) { Mat3 R; R << -c, 0, -s, 0, 0, 0, s, 0, -c; return R; }
+Mat3 dd_rot_z(double c, double s) { Mat3 R; R << -c, s, 0, -s, -c, 0, 0, 0, 0; return R; }
 }  // namespace
 
-void deformation_transform(const Vec6& q, DeformationTransform& out) {
-  const Mat3 F[3] = {rot_x(q[3]), rot_y(q[4]), rot_z(q[5])};
-  static const Mat3 G[3] = {generator(0), generator(1), generator(2)};
-  // Factor a differentiated k times is F_a G_a^k (rotations about one axis commute with G_a).
-  auto factor = [&](int a, int k) -> Mat3 {
-    Mat3 f = F[a];
-    for (int i = 0; i < k; ++i) f = f * G[a];
-    return f;
-  };
-  const Mat3 R = F[0] * F[1] * F[2];
-  out.D = homogeneous(R, q.head<3>());
+void deformation_transform(const Vec6& q, DeformationTransform& out, bool second) {
+  const double c1 = std::cos(q[3]), s1 = std::sin(q[3]), c2 = std::cos(q[4]), s2 = std::sin(q[4]);
+  const double c3 = std::cos(q[5]), s3 = std::sin(q[5]);
+  Mat3 Rx, Ry, Rz;
+  Rx << 1, 0, 0, 0, c1, -s1, 0, s1, c1;
+  Ry << c2, 0, s2, 0, 1, 0, -s2, 0, c2;
+  Rz << c3, -s3, 0, s3, c3, 0, 0, 0, 1;
+  const Mat3 dRx = d_rot_x(c1, s1), dRy = d_rot_y(c2, s2), dRz = d_rot_z(c3, s3);
+  const Mat3 RyRz = Ry * Rz, RxRy = Rx * Ry;
+  out.D = homogeneous(Rx * RyRz, q.head<3>());
   for (int j = 0; j < 3; ++j) {
     out.dD[j].setZero();
     out.dD[j](j, 3) = 1.0;
   }
+  out.dR[0] = dRx * RyRz;
+  out.dR[1] = Rx * (dRy * Rz);
+  out.dR[2] = RxRy * dRz;
   for (int a = 0; a < 3; ++a) {
-    int k[3] = {0, 0, 0};
-    k[a] = 1;
-    out.dR[a] = factor(0, k[0]) * factor(1, k[1]) * factor(2, k[2]);
     out.dD[3 + a].setZero();
     out.dD[3 + a].leftCols<3>() = out.dR[a];
   }
-  for (int a = 0; a < 3; ++a)
-    for (int b = a; b < 3; ++b) {
-      int k[3] = {0, 0, 0};
-      ++k[a];
-      ++k[b];
-      out.ddR[a][b] = factor(0, k[0]) * factor(1, k[1]) * factor(2, k[2]);
-      out.ddR[b][a] = out.ddR[a][b];
-    }
+  if (!second) return;
+  out.ddR[0][0] = dd_rot_x(c1, s1) * RyRz;
+  out.ddR[1][1] = Rx * (dd_rot_y(c2, s2) * Rz);
+  out.ddR[2][2] = RxRy * dd_rot_z(c3, s3);
+  out.ddR[0][1] = out.ddR[1][0] = dRx * (dRy * Rz);
+  out.ddR[0][2] = out.ddR[2][0] = (dRx * Ry) * dRz;
+  out.ddR[1][2] = out.ddR[2][1] = Rx * (dRy * dRz);
 }
 
 Mat34 d_dot(const DeformationTransform& d, const Vec6& v) {
-  Mat34 r = Mat34::Zero();
-  for (int j = 0; j < 6; ++j) r += d.dD[j] * v[j];
+  Mat34 r;
+  r.leftCols<3>() = d.dR[0] * v[3] + d.dR[1] * v[4] + d.dR[2] * v[5];
+  r.col(3) = v.head<3>();
   return r;
 }
 
 Mat34 d_ddot(const DeformationTransform& d, const Vec6& v, const Vec6& a) {
-  Mat34 r = Mat34::Zero();
-  for (int j = 0; j < 6; ++j) r += d.dD[j] * a[j];
-  Mat3 quad = Mat3::Zero();
-  for (int i = 0; i < 3; ++i)
-    for (int l = 0; l < 3; ++l) quad += d.ddR[i][l] * (v[3 + i] * v[3 + l]);
-  r.leftCols<3>() += quad;
+  Mat34 r;
+  Mat3 m = d.dR[0] * a[3] + d.dR[1] * a[4] + d.dR[2] * a[5];
+  for (int i = 0; i < 3; ++i) {
+    m += d.ddR[i][i] * (v[3 + i] * v[3 + i]);
+    for (int l = i + 1; l < 3; ++l) m += d.ddR[i][l] * (2.0 * v[3 + i] * v[3 + l]);
+  }
+  r.leftCols<3>() = m;
+  r.col(3) = a.head<3>();
   return r;
 }
 

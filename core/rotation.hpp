@@ -20,8 +20,8 @@ struct DeformationTransform {
   std::array<Mat3, 3> dR;           ///< ∂R/∂φ_a
 };
 
-/// Evaluates D(q), ∂D/∂q and ∂²R/∂φ² for one rfe.
-void deformation_transform(const Vec6& q, DeformationTransform& out);
+/// Evaluates D(q), ∂D/∂q and, if `second`, ∂²R/∂φ² for one rfe (left unset otherwise).
+void deformation_transform(const Vec6& q, DeformationTransform& out, bool second = true);
 
 /// Ḋ = Σ ∂D/∂q_j q̇_j and D̈ = Σ ∂D/∂q_j q̈_j + Σ ∂²D/∂q_j∂q_l q̇_j q̇_l (top rows).
 Mat34 d_dot(const DeformationTransform& d, const Vec6& v);
