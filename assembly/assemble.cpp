@@ -108,10 +108,12 @@ void generalised_forces(const Model& model, const VecX& q, const VecX& v, const 
 }
 
 void assemble_matrix(const Model& model, const BorderedPattern& pattern, const std::vector<int>& base_col,
-                     const VecX& q, const VecX& v, const MatrixTerms& t, std::vector<double>& values) {
+                     const VecX& q, const VecX& v, const MatrixTerms& t, std::vector<double>& values,
+                     std::vector<double>* sde_stiffness) {
   const int n = model.n(), m = model.m();
   const Discretisation& d = model.link;
   values.assign(pattern.nnz(), 0.0);
+  if (sde_stiffness) sde_stiffness->assign(pattern.nnz(), 0.0);
   BaseKinematics bk;
   const VecX zero = VecX::Zero(model.dof());
   base_kin(model, q, v, zero, bk);
@@ -149,19 +151,23 @@ void assemble_matrix(const Model& model, const BorderedPattern& pattern, const s
 #pragma omp parallel for schedule(static) if (n >= g_parallel_min)
     for (int e = colour; e < n; e += 2) {
       const Sde& s = d.sdes[e];
-      Mat12 S = Mat12::Zero();
+      Mat12 S = Mat12::Zero(), K = Mat12::Zero();
       const Vec6 ql = left_coords(q, e);
       sde_matrix(s, left_centre(d, s), d.rfes[e].centre, d.damping_beta, ql, rfe_coords(q, e), t.stiffness,
-                 t.damping, S);
+                 t.damping, S, sde_stiffness ? &K : nullptr);
       const int p0 = 6 * e, l0 = 6 * (e - 1);
-      for (int b = 0; b < 6; ++b)
-        for (int a = 0; a <= b; ++a) values[pattern.slot(p0 + a, p0 + b)] += S(6 + a, 6 + b);
-      if (e > 0) {
+      auto scatter = [&](const Mat12& A, std::vector<double>& vals) {
         for (int b = 0; b < 6; ++b)
-          for (int a = 0; a <= b; ++a) values[pattern.slot(l0 + a, l0 + b)] += S(a, b);
-        for (int b = 0; b < 6; ++b)
-          for (int a = 0; a < 6; ++a) values[pattern.slot(l0 + a, p0 + b)] += S(a, 6 + b);
-      }
+          for (int a = 0; a <= b; ++a) vals[pattern.slot(p0 + a, p0 + b)] += A(6 + a, 6 + b);
+        if (e > 0) {
+          for (int b = 0; b < 6; ++b)
+            for (int a = 0; a <= b; ++a) vals[pattern.slot(l0 + a, l0 + b)] += A(a, b);
+          for (int b = 0; b < 6; ++b)
+            for (int a = 0; a < 6; ++a) vals[pattern.slot(l0 + a, p0 + b)] += A(a, 6 + b);
+        }
+      };
+      scatter(S, values);
+      if (sde_stiffness) scatter(K, *sde_stiffness);
     }
   }
   BaseMoments flex;

@@ -35,8 +35,11 @@ struct MatrixTerms {
 };
 
 /// Assembles S into `values` (pattern.nnz()); base_col[j] is joint j's column or −1 if held.
+/// If `sde_stiffness` is given, the sde stiffness alone (K with stiffness = 1, no gravity or
+/// inertial terms) goes there in the same pass (the Newton solve needs both S and K).
 void assemble_matrix(const Model& model, const BorderedPattern& pattern, const std::vector<int>& base_col,
-                     const VecX& q, const VecX& v, const MatrixTerms& terms, std::vector<double>& values);
+                     const VecX& q, const VecX& v, const MatrixTerms& terms, std::vector<double>& values,
+                     std::vector<double>* sde_stiffness = nullptr);
 
 /// The symmetric matrix of a pattern's values, dense (tests and small systems).
 MatX to_dense(const BorderedPattern& pattern, const std::vector<double>& values);

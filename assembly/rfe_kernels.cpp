@@ -37,8 +37,14 @@ void rfe_gravity_force(const Rfe& rfe, const RfePose& p, double g, Vec6& f, Vec4
 
 void rfe_mass_blocks(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, Mat6& Mkk,
                      MatX& border, Mat4& G) {
-  for (int j = 0; j < 6; ++j)
-    for (int l = j; l < 6; ++l) Mkk(j, l) = Mkk(l, j) = trace_AHBt(p.d.dD[j], rfe.H, p.d.dD[l]);
+  // H = [J 0; 0 m]: translations carry m I, rotations tr(∂R_a J ∂R_bᵀ), no coupling between them.
+  Mkk.setZero();
+  Mkk.topLeftCorner<3, 3>().diagonal().setConstant(rfe.mass);
+  const Mat3 J = rfe.H.topLeftCorner<3, 3>();
+  for (int a = 0; a < 3; ++a) {
+    const Mat3 dRJ = p.d.dR[a] * J;
+    for (int b = a; b < 3; ++b) Mkk(3 + a, 3 + b) = Mkk(3 + b, 3 + a) = (dRJ.array() * p.d.dR[b].array()).sum();
+  }
   const Mat4 WH = p.W * rfe.H;
   const int m = static_cast<int>(bk.Xi.size());
   border.resize(m, 6);

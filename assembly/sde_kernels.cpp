@@ -52,7 +52,7 @@ void sde_forces(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const
 }
 
 void sde_matrix(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const Vec6& ql,
-                const Vec6& qp, double ck, double cd, Mat12& S) {
+                const Vec6& qp, double ck, double cd, Mat12& S, Mat12* K) {
   SdeGeometry g;
   geometry(e, cl, cr, ql, qp, g, true);
   Mat12 base = g.J.transpose() * e.c.asDiagonal() * g.J;  // Jᵀ c J
@@ -67,12 +67,19 @@ void sde_matrix(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const
     base.leftCols<6>().setZero();
   }
   S.noalias() += (ck + cd * beta) * base;
+  if (K) K->noalias() += base;
   // Geometric term Σ_i λ_i ∂²Δx_i/∂φ∂φ, λ = c Δx (the spring force turning with the rfe).
   const Vec3 lam = e.c.cwiseProduct(g.dx);
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) {
-      S(9 + a, 9 + b) += ck * lam.dot(g.dp.ddR[a][b] * e.eta_right);
-      if (e.left >= 0) S(3 + a, 3 + b) -= ck * lam.dot(g.dl.ddR[a][b] * e.eta_left);
+      const double gp = lam.dot(g.dp.ddR[a][b] * e.eta_right);
+      S(9 + a, 9 + b) += ck * gp;
+      if (K) (*K)(9 + a, 9 + b) += gp;
+      if (e.left >= 0) {
+        const double gl = lam.dot(g.dl.ddR[a][b] * e.eta_left);
+        S(3 + a, 3 + b) -= ck * gl;
+        if (K) (*K)(3 + a, 3 + b) -= gl;
+      }
     }
 }
 

@@ -19,8 +19,8 @@ void sde_forces(const Sde& e, const Vec3& centre_left, const Vec3& centre_right,
                 const Vec6& ql, const Vec6& vl, const Vec6& qp, const Vec6& vp, SdeResult& out);
 
 /// Stiffness K = ∂²V/∂q² (with the geometric term of the rotated attachment points) and damping
-/// C = β (Jᵀ diag(c) J + rotational part): S += ck K + cd C.
+/// C = β (Jᵀ diag(c) J + rotational part): S += ck K + cd C, and K itself into *K if given.
 void sde_matrix(const Sde& e, const Vec3& centre_left, const Vec3& centre_right, double beta,
-                const Vec6& ql, const Vec6& qp, double ck, double cd, Mat12& S);
+                const Vec6& ql, const Vec6& qp, double ck, double cd, Mat12& S, Mat12* K = nullptr);
 
 }  // namespace rfem

@@ -8,6 +8,7 @@ cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j "$(nproc)"
 set -x
 build/apps/rfem run cases/paper_deployment.toml -o paper_deployment.h5
+build/apps/rfem plot paper_deployment.h5 -o figures
 build/apps/rfem modes cases/kane_beam.toml --count 8
 build/apps/rfem refine cases/kane_beam.toml --n 5,10,20,40,80 --quantity bending-y:1
 build/apps/rfem static cases/kane_beam.toml

@@ -10,10 +10,7 @@ bool NewtonSystem::setup(const VecX& q, const VecX& v, double c) {
   terms.mass = c * c;
   terms.damping = c;
   terms.stiffness = 1.0;
-  assemble_matrix(model_, pattern_, base_col_, q, v, terms, S_);
-  MatrixTerms kt;
-  kt.stiffness = 1.0;
-  assemble_matrix(model_, pattern_, base_col_, q, v, kt, K_);
+  assemble_matrix(model_, pattern_, base_col_, q, v, terms, S_, &K_);
   c_ = c;
   return solver_.factorize(S_);
 }
