@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <stdexcept>
 
@@ -138,8 +139,16 @@ struct IdaHandles {
   }
 };
 
+// IDAGetReturnFlagName returns a malloc'ed string.
+std::string flag_name(int flag) {
+  char* s = IDAGetReturnFlagName(flag);
+  std::string name(s ? s : "?");
+  std::free(s);
+  return name;
+}
+
 void check(int flag, const char* what) {
-  if (flag < 0) throw std::runtime_error(std::string(what) + " failed: " + IDAGetReturnFlagName(flag));
+  if (flag < 0) throw std::runtime_error(std::string(what) + " failed: " + flag_name(flag));
 }
 
 // Accelerations of the unknowns from the equations of motion at state y:
@@ -303,7 +312,7 @@ RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, 
       IDAGetCurrentTime(h.ida, &tcur);
       char buf[160];
       std::snprintf(buf, sizeof buf, " at t = %.6g s (last step %.3g s)", tcur, out.stats.last_step);
-      out.status = std::string("failed: IDA ") + IDAGetReturnFlagName(flag) + buf +
+      out.status = "failed: IDA " + flag_name(flag) + buf +
                    "; try looser tolerances, a smaller max_step, or check the inputs";
       return out;
     }

@@ -4,8 +4,8 @@
     /usr/bin/python3 compare.py RFEM.h5 SIMBODY.csv [RFEM.h5 SIMBODY.csv ...] [--group run]
 
 One row per pair: n, peak |u1| of each, relative difference of the peaks, max |Δu1| over the common
-output times (and when it occurs), u1 at 15 s and 20 s, wall time of each and their ratio, and the
-step counts. Run with Debian's /usr/bin/python3 (needs python3-h5py and python3-numpy).
+output times (and when it occurs), u1 at 15 s and 20 s, wall time of each (and Simbody's CPU time),
+the wall-time ratio Simbody/rfem, and the step counts. Run with Debian's /usr/bin/python3 (needs python3-h5py and python3-numpy).
 """
 import argparse
 import re
@@ -31,22 +31,29 @@ def read_rfem(path, group):
 
 
 def read_simbody(path):
-    data = np.genfromtxt(path, delimiter=",", comments="#", names=True)
-    meta = {"wall": float("nan"), "steps": -1, "n": -1}
-    # The header comment carries n, the trailer comment the wall time and steps (absent if the run
-    # was cut short).
+    meta = {"wall": float("nan"), "cpu": float("nan"), "steps": -1, "n": -1}
+    header, rows = None, []
+    # '#' lines: the first carries n, the last the wall time and steps (absent if the run was cut
+    # short). The first other line names the columns.
     with open(path) as fh:
         for line in fh:
             if not line.startswith("#"):
+                if header is None:
+                    header = line.strip().split(",")
+                else:
+                    rows.append([float(x) for x in line.split(",")])
                 continue
             for key, val in re.findall(r"(\w+)=(\S+)", line):
                 if key == "n":
                     meta["n"] = int(val)
                 elif key == "wall_time_s":
                     meta["wall"] = float(val)
+                elif key == "cpu_time_s":
+                    meta["cpu"] = float(val)
                 elif key == "steps":
                     meta["steps"] = int(val)
-    return {"t": np.atleast_1d(data["t"]), "u1": np.atleast_1d(data["u1"]), **meta}
+    data = np.array(rows).reshape(-1, len(header))
+    return {"t": data[:, header.index("t")], "u1": data[:, header.index("u1")], **meta}
 
 
 def value_at(t, u, when):
@@ -76,6 +83,7 @@ def compare(r, s):
         "u1_15": (value_at(t, ur, 15.0), value_at(t, us, 15.0)),
         "u1_20": (value_at(t, ur, 20.0), value_at(t, us, 20.0)),
         "wall": (r["wall"], s["wall"]),
+        "cpu_simbody": s["cpu"],
         "steps": (r["steps"], s["steps"]),
         "t_end": t[-1],
     }
@@ -100,14 +108,14 @@ def main(argv):
 
     hdr = (f"{'n':>4} {'peak|u1| rfem':>14} {'peak|u1| simb':>14} {'rel diff':>10} {'max|du1| [m]':>12}"
            f" {'at t':>6} {'/peak':>9} {'u1(15) rfem':>12} {'u1(15) simb':>12} {'u1(20) rfem':>12}"
-           f" {'u1(20) simb':>12} {'wall rfem':>9} {'wall simb':>9} {'ratio':>7} {'steps rfem':>10} {'steps simb':>10}")
+           f" {'u1(20) simb':>12} {'wall rfem':>9} {'wall simb':>9} {'cpu simb':>9} {'ratio':>7} {'steps rfem':>10} {'steps simb':>10}")
     print(hdr)
     for c in rows:
         ratio = c["wall"][1] / c["wall"][0] if c["wall"][0] > 0 else float("nan")
         print(f"{c['n']:>4} {c['peak_rfem']:>14.9f} {c['peak_simbody']:>14.9f} {c['peak_rel']:>+10.2e}"
               f" {c['max_du1']:>12.3e} {c['t_max_du1']:>6.2f} {c['du1_over_peak']:>9.2e}"
               f" {c['u1_15'][0]:>12.6f} {c['u1_15'][1]:>12.6f} {c['u1_20'][0]:>12.6f} {c['u1_20'][1]:>12.6f}"
-              f" {c['wall'][0]:>9.3f} {c['wall'][1]:>9.2f} {ratio:>7.0f} {c['steps'][0]:>10d} {c['steps'][1]:>10d}")
+              f" {c['wall'][0]:>9.3f} {c['wall'][1]:>9.2f} {c['cpu_simbody']:>9.2f} {ratio:>7.0f} {c['steps'][0]:>10d} {c['steps'][1]:>10d}")
         if c["t_end"] < 20.0 - 1e-9:
             print(f"     (compared up to t = {c['t_end']:g} s only)")
     return 0
