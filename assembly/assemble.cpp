@@ -23,6 +23,16 @@ struct BaseMoments {  // Σ over bodies of Y = W H Ẅᵀ, G = W H Wᵀ, s = W H
   }
 };
 
+// rfe_0's rotation (zero coordinates): R = I, ∂R/∂φ the generators.
+const RfeRotation& clamp_rotation() {
+  static const RfeRotation r = [] {
+    DeformationTransform d;
+    deformation_transform(Vec6::Zero(), d, false);
+    return rfe_rotation(d);
+  }();
+  return r;
+}
+
 Vec3 left_centre(const Discretisation& d, const Sde& e) {
   return e.left < 0 ? d.rfe0.centre : d.rfes[e.left].centre;
 }
@@ -66,11 +76,17 @@ void generalised_forces(const Model& model, const VecX& q, const VecX& v, const 
   base_kin(model, q, vi, a, bk);
   const int nchunks = (n + kChunk - 1) / kChunk;
   std::vector<BaseMoments> chunk(nchunks);
+  // Each rfe's rotation, evaluated once here and reused by both sdes that touch it. The buffer is
+  // per calling thread; the reference (shared in the parallel regions) names the caller's buffer.
+  thread_local std::vector<RfeRotation> rotation_buffer;
+  std::vector<RfeRotation>& rotations = rotation_buffer;
+  rotations.resize(n);
 #pragma omp parallel for schedule(static) if (n >= g_parallel_min)
   for (int c = 0; c < nchunks; ++c) {
     RfePose pose;
     for (int k = c * kChunk; k < std::min(n, (c + 1) * kChunk); ++k) {
       rfe_pose(d.rfes[k], bk, rfe_coords(q, k), rfe_coords(vi, k), rfe_coords(a, k), pose);
+      rotations[k] = rfe_rotation(pose.d);
       Vec6 f = Vec6::Zero(), fg;
       Mat4 Y;
       Vec4 s;
@@ -91,7 +107,8 @@ void generalised_forces(const Model& model, const VecX& q, const VecX& v, const 
         const Sde& s = d.sdes[e];
         const Vec6 ql = left_coords(q, e), vl = left_coords(v, e);
         SdeResult r;
-        sde_forces(s, left_centre(d, s), d.rfes[e].centre, beta, ql, vl, rfe_coords(q, e), rfe_coords(v, e), r);
+        sde_forces(s, left_centre(d, s), d.rfes[e].centre, beta, ql, vl, rfe_coords(q, e), rfe_coords(v, e),
+                   e > 0 ? rotations[e - 1] : clamp_rotation(), rotations[e], r);
         if (e > 0) F.segment<6>(6 * (e - 1)) += r.f.head<6>();
         F.segment<6>(6 * e) += r.f.tail<6>();
       }

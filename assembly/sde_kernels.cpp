@@ -10,44 +10,58 @@ struct SdeGeometry {
   DeformationTransform dl, dp;
 };
 
+// Δx and J from both rfes' rotations.
+void displacement(const Sde& e, const Vec3& cl, const Vec3& cr, const Vec6& ql, const Vec6& qp, const RfeRotation& rl,
+                  const RfeRotation& rp, Vec3& dx, Eigen::Matrix<double, 3, 12>& J) {
+  const bool has_left = e.left >= 0;
+  const Vec3 pl = cl + rl.R * e.eta_left + (has_left ? ql.head<3>() : Vec3::Zero().eval());
+  const Vec3 pr = cr + rp.R * e.eta_right + qp.head<3>();
+  dx = pr - pl;
+  J.setZero();
+  J.block<3, 3>(0, 6) = Mat3::Identity();
+  for (int a = 0; a < 3; ++a) J.col(9 + a) = rp.dR[a] * e.eta_right;
+  if (has_left) {
+    J.block<3, 3>(0, 0) = -Mat3::Identity();
+    for (int a = 0; a < 3; ++a) J.col(3 + a) = -(rl.dR[a] * e.eta_left);
+  }
+}
+
 // `second`: also ∂²R/∂φ² (the geometric stiffness needs it, the forces do not).
 void geometry(const Sde& e, const Vec3& cl, const Vec3& cr, const Vec6& ql, const Vec6& qp, SdeGeometry& g,
               bool second) {
-  const bool has_left = e.left >= 0;
-  deformation_transform(has_left ? ql : Vec6::Zero().eval(), g.dl, second);
+  deformation_transform(e.left >= 0 ? ql : Vec6::Zero().eval(), g.dl, second);
   deformation_transform(qp, g.dp, second);
-  const Vec3 pl = cl + g.dl.D.topLeftCorner<3, 3>() * e.eta_left + g.dl.D.topRightCorner<3, 1>();
-  const Vec3 pr = cr + g.dp.D.topLeftCorner<3, 3>() * e.eta_right + g.dp.D.topRightCorner<3, 1>();
-  g.dx = pr - pl;
-  g.J.setZero();
-  g.J.block<3, 3>(0, 0) = -Mat3::Identity();
-  g.J.block<3, 3>(0, 6) = Mat3::Identity();
-  for (int a = 0; a < 3; ++a) {
-    g.J.col(3 + a) = -(g.dl.dR[a] * e.eta_left);
-    g.J.col(9 + a) = g.dp.dR[a] * e.eta_right;
-  }
-  if (!has_left) g.J.leftCols<6>().setZero();
+  displacement(e, cl, cr, ql, qp, rfe_rotation(g.dl), rfe_rotation(g.dp), g.dx, g.J);
 }
 
 }  // namespace
 
-void sde_forces(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const Vec6& ql,
-                const Vec6& vl, const Vec6& qp, const Vec6& vp, SdeResult& out) {
-  SdeGeometry g;
-  geometry(e, cl, cr, ql, qp, g, false);
+void sde_forces(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const Vec6& ql, const Vec6& vl,
+                const Vec6& qp, const Vec6& vp, SdeResult& out) {
+  DeformationTransform dl, dp;
+  deformation_transform(e.left >= 0 ? ql : Vec6::Zero().eval(), dl, false);
+  deformation_transform(qp, dp, false);
+  sde_forces(e, cl, cr, beta, ql, vl, qp, vp, rfe_rotation(dl), rfe_rotation(dp), out);
+}
+
+void sde_forces(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const Vec6& ql, const Vec6& vl,
+                const Vec6& qp, const Vec6& vp, const RfeRotation& rl, const RfeRotation& rp, SdeResult& out) {
+  Vec3 dx;
+  Eigen::Matrix<double, 3, 12> J;
+  displacement(e, cl, cr, ql, qp, rl, rp, dx, J);
   const bool has_left = e.left >= 0;
   const Vec3 dphi = qp.tail<3>() - (has_left ? ql.tail<3>() : Vec3::Zero().eval());
   Vec12 qdot;
   qdot << (has_left ? vl : Vec6::Zero().eval()), vp;
-  const Vec3 dx_dot = g.J * qdot;
+  const Vec3 dx_dot = J * qdot;
   const Vec3 dphi_dot = qdot.segment<3>(9) - qdot.segment<3>(3);
-  const Vec3 lam = e.c.cwiseProduct(g.dx + beta * dx_dot);       // spring + damper force
-  const Vec3 mu = e.k.cwiseProduct(dphi + beta * dphi_dot);       // spring + damper moment
-  out.f = g.J.transpose() * lam;
+  const Vec3 lam = e.c.cwiseProduct(dx + beta * dx_dot);     // spring + damper force
+  const Vec3 mu = e.k.cwiseProduct(dphi + beta * dphi_dot);  // spring + damper moment
+  out.f = J.transpose() * lam;
   out.f.segment<3>(3) -= mu;
   out.f.segment<3>(9) += mu;
   if (!has_left) out.f.head<6>().setZero();
-  out.V = 0.5 * g.dx.dot(e.c.cwiseProduct(g.dx)) + 0.5 * dphi.dot(e.k.cwiseProduct(dphi));
+  out.V = 0.5 * dx.dot(e.c.cwiseProduct(dx)) + 0.5 * dphi.dot(e.k.cwiseProduct(dphi));
   out.P_d = beta * (dx_dot.dot(e.c.cwiseProduct(dx_dot)) + dphi_dot.dot(e.k.cwiseProduct(dphi_dot)));
 }
 

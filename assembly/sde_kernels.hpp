@@ -17,6 +17,10 @@ struct SdeResult {
 /// Forces, energy and dissipation of sde `e` (ql/vl ignored when e.left == −1).
 void sde_forces(const Sde& e, const Vec3& centre_left, const Vec3& centre_right, double beta,
                 const Vec6& ql, const Vec6& vl, const Vec6& qp, const Vec6& vp, SdeResult& out);
+/// The same with both rfes' rotations already evaluated (the residual evaluates each rfe once).
+void sde_forces(const Sde& e, const Vec3& centre_left, const Vec3& centre_right, double beta,
+                const Vec6& ql, const Vec6& vl, const Vec6& qp, const Vec6& vp, const RfeRotation& rl,
+                const RfeRotation& rp, SdeResult& out);
 
 /// Stiffness K = ∂²V/∂q² (with the geometric term of the rotated attachment points) and damping
 /// C = β (Jᵀ diag(c) J + rotational part): S += ck K + cd C, and K itself into *K if given.

@@ -64,6 +64,8 @@ void deformation_transform(const Vec6& q, DeformationTransform& out, bool second
   out.ddR[1][2] = out.ddR[2][1] = Rx * (dRy * dRz);
 }
 
+RfeRotation rfe_rotation(const DeformationTransform& d) { return {d.D.topLeftCorner<3, 3>(), d.dR}; }
+
 Mat34 d_dot(const DeformationTransform& d, const Vec6& v) {
   Mat34 r;
   r.leftCols<3>() = d.dR[0] * v[3] + d.dR[1] * v[4] + d.dR[2] * v[5];

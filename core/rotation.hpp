@@ -20,6 +20,13 @@ struct DeformationTransform {
   std::array<Mat3, 3> dR;           ///< ∂R/∂φ_a
 };
 
+/// R(φ) and ∂R/∂φ of one rfe: all the sde forces need (kept per rfe during a residual evaluation).
+struct RfeRotation {
+  Mat3 R;
+  std::array<Mat3, 3> dR;
+};
+RfeRotation rfe_rotation(const DeformationTransform& d);
+
 /// Evaluates D(q), ∂D/∂q and, if `second`, ∂²R/∂φ² for one rfe (left unset otherwise).
 void deformation_transform(const Vec6& q, DeformationTransform& out, bool second = true);
 

@@ -1,5 +1,7 @@
 #include "solvers/newton_system.hpp"
 
+#include <Eigen/SparseCore>
+
 namespace rfem {
 
 NewtonSystem::NewtonSystem(const Model& model, std::vector<int> base_col, int nb)
@@ -23,16 +25,11 @@ bool NewtonSystem::setup_mass(const VecX& q, const VecX& v) {
 }
 
 void NewtonSystem::stiffness_times(const double* x, double* y) const {
-  const auto& cp = pattern_.colptr();
-  const auto& ri = pattern_.rowind();
+  // The stored upper triangle as an Eigen sparse view: its symmetric product is vectorised.
   const int N = pattern_.size();
-  std::fill(y, y + N, 0.0);
-  for (int c = 0; c < N; ++c)
-    for (long k = cp[c]; k < cp[c + 1]; ++k) {
-      const long r = ri[k];
-      y[r] += K_[k] * x[c];
-      if (r != c) y[c] += K_[k] * x[r];
-    }
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::ColMajor, long>> K(
+      N, N, pattern_.nnz(), pattern_.colptr().data(), pattern_.rowind().data(), K_.data());
+  Eigen::Map<VecX>(y, N).noalias() = K.selfadjointView<Eigen::Upper>() * Eigen::Map<const VecX>(x, N);
 }
 
 void NewtonSystem::solve(const double* b, double* x) const {
