@@ -95,7 +95,7 @@ bool parse_dynamic(const Case& cs, const std::string& quantity, DynamicQuantity&
 double evaluate_dynamic(const Case& cs, const std::vector<JointInput>& inputs, int n, const DynamicQuantity& d,
                         ResultsFile& file, bool quiet) {
   const Model model = build_model(cs, n);
-  const std::string prefix = "n" + std::to_string(n) + "/";
+  const std::string prefix = fmt::format("n{}/", n);  // (fmt: GCC 12 warns falsely on "n" + to_string)
   double value = d.time < 0 ? 0.0 : NAN, best_dt = 1e300;
   auto observe = [&](const std::string& run, const Model& m, const OutputSample& s) {
     if (run != prefix + d.run) return;
