@@ -2,11 +2,7 @@
 # Nothing lost: a run interrupted by SIGINT or SIGTERM, and a run the integrator gives up on,
 # leave a valid HDF5 file with every completed output step and the reason in `status`.
 set -uo pipefail
-rfem=$1
-src=$(cd "$(dirname "$0")/.." && pwd)
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-cd "$dir"
+source "$(dirname "$0")/cli_test_env.sh"
 fail=0
 
 check() {  # file group expected-status-prefix

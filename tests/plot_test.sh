@@ -1,11 +1,7 @@
 #!/usr/bin/env bash
 # rfem plot writes every expected PNG for the paper's case, and none is blank (pixel spread).
 set -euo pipefail
-rfem=$1
-src=$(cd "$(dirname "$0")/.." && pwd)
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-cd "$dir"
+source "$(dirname "$0")/cli_test_env.sh"
 "$rfem" run "$src/cases/paper_deployment.toml" --quiet --set simulation.t_end=4 -o paper.h5
 "$rfem" plot paper.h5 -o figs >/dev/null
 /usr/bin/python3 - figs <<'PY'

@@ -3,11 +3,7 @@
 # ≈ 2 over n = 6, 12, 24 (second-order RFEM), every run and the table land in one HDF5 file, and
 # rfem plot draws its convergence figure.
 set -euo pipefail
-rfem=$1
-src=$(cd "$(dirname "$0")/.." && pwd)
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-cd "$dir"
+source "$(dirname "$0")/cli_test_env.sh"
 "$rfem" refine "$src/cases/kane_spinup.toml" --n 6,12,24 --quantity peak:u1 --set simulation.t_end=8 -q -o ref.h5 --json > ref.json
 /usr/bin/python3 - <<'PY'
 import json, sys, h5py
