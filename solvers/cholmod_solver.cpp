@@ -17,27 +17,35 @@ CholmodSolver::CholmodSolver(const BorderedPattern& pattern) : pattern_(pattern)
   common_->postorder = 0;
   common_->print = 0;
   common_->quick_return_if_not_posdef = 1;
-  const long N = pattern.size();
-  A_ = cholmod_l_allocate_sparse(N, N, pattern.nnz(), /*sorted*/ 1, /*packed*/ 1, /*stype upper*/ 1,
-                                 CHOLMOD_REAL, common_);
-  if (!A_) throw std::runtime_error("CHOLMOD could not allocate the matrix");
-  std::copy(pattern.colptr().begin(), pattern.colptr().end(), static_cast<SuiteSparse_long*>(A_->p));
-  std::copy(pattern.rowind().begin(), pattern.rowind().end(), static_cast<SuiteSparse_long*>(A_->i));
-  std::fill_n(static_cast<double*>(A_->x), pattern.nnz(), 0.0);
+  // A views the pattern's arrays and, at each factorisation, the caller's values: no copies.
+  static_assert(sizeof(SuiteSparse_long) == sizeof(long));
+  A_ = new cholmod_sparse{};
+  A_->nrow = A_->ncol = static_cast<size_t>(pattern.size());
+  A_->nzmax = static_cast<size_t>(pattern.nnz());
+  A_->p = const_cast<long*>(pattern.colptr().data());
+  A_->i = const_cast<long*>(pattern.rowind().data());
+  A_->stype = 1;  // upper triangle stored
+  A_->itype = CHOLMOD_LONG;
+  A_->xtype = CHOLMOD_PATTERN;  // the analysis needs no values
+  A_->dtype = CHOLMOD_DOUBLE;
+  A_->sorted = 1;
+  A_->packed = 1;
   L_ = cholmod_l_analyze(A_, common_);
+  A_->xtype = CHOLMOD_REAL;
   if (!L_) throw std::runtime_error("CHOLMOD analysis failed");
 }
 
 CholmodSolver::~CholmodSolver() {
   if (L_) cholmod_l_free_factor(&L_, common_);
-  if (A_) cholmod_l_free_sparse(&A_, common_);
+  delete A_;  // its arrays belong to the pattern and the caller
   cholmod_l_finish(common_);
   delete common_;
 }
 
 bool CholmodSolver::factorize(const std::vector<double>& values) {
-  std::copy(values.begin(), values.end(), static_cast<double*>(A_->x));
+  A_->x = const_cast<double*>(values.data());
   cholmod_l_factorize(A_, L_, common_);
+  A_->x = nullptr;
   if (common_->status == CHOLMOD_NOT_POSDEF) {
     failed_column_ = static_cast<long>(L_->minor);
     return false;

@@ -11,6 +11,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "solvers/mass_solve.hpp"
 #include "solvers/newton_system.hpp"
 
 namespace rfem {
@@ -25,7 +26,8 @@ struct Problem {
   ForceTerms terms;
   std::vector<int> unknown;   ///< full index of each unknown coordinate
   std::vector<int> base_col;  ///< joint → column among the unknowns, −1 if prescribed
-  std::unique_ptr<NewtonSystem> newton, output_solver;
+  std::unique_ptr<NewtonSystem> newton;
+  std::vector<double> mass_values;  ///< scratch of the output accelerations' mass solve
   double cj_factor = 0.0;
   VecX q, v, a, F;            ///< full-coordinate scratch
   bool damped;
@@ -164,9 +166,8 @@ VecX consistent_accelerations(Problem& p, double t, const double* y) {
     const int k = p.unknown[i];
     rhs[i] = (k >= n6 ? tau[k - n6] : 0.0) - p.F[k];
   }
-  if (!p.output_solver->setup_mass(p.q, p.v))
+  if (!solve_mass(p.model, p.newton->pattern(), p.base_col, p.q, p.v, rhs, p.mass_values))
     throw std::runtime_error("the mass matrix is not positive definite at t = " + std::to_string(t));
-  p.output_solver->solve_mass(rhs);
   return rhs;
 }
 
@@ -207,7 +208,6 @@ RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, 
       p.unknown.push_back(n6 + j);
     }
   p.newton = std::make_unique<NewtonSystem>(model, p.base_col, nb);
-  p.output_solver = std::make_unique<NewtonSystem>(model, p.base_col, nb);  // keeps IDA's factor intact
   const int u = p.nu(), N = 2 * u + 2;
   const long n_out = std::lround(std::ceil(opts.t_end / opts.output_dt - 1e-9));
   RunOutcome out;

@@ -17,13 +17,6 @@ bool NewtonSystem::setup(const VecX& q, const VecX& v, double c) {
   return solver_.factorize(S_);
 }
 
-bool NewtonSystem::setup_mass(const VecX& q, const VecX& v) {
-  MatrixTerms mt;
-  mt.mass = 1.0;
-  assemble_matrix(model_, pattern_, base_col_, q, v, mt, S_);
-  return solver_.factorize(S_);
-}
-
 void NewtonSystem::stiffness_times(const double* x, double* y) const {
   // The stored upper triangle as an Eigen sparse view: its symmetric product is vectorised.
   const int N = pattern_.size();

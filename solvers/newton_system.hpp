@@ -19,10 +19,6 @@ class NewtonSystem {
   bool setup(const VecX& q, const VecX& v, double c);
   /// Solves for x = [x1; x2] (2·size()) given b (2·size()), with the c of the last setup.
   void solve(const double* b, double* x) const;
-  /// Factorises the mass matrix alone (c = 1, no C, K) for consistent initial accelerations;
-  /// then solve_mass(b) gives M⁻¹ b.
-  bool setup_mass(const VecX& q, const VecX& v);
-  void solve_mass(VecX& b) const { solver_.solve(b); }
   int size() const { return pattern_.size(); }
   const BorderedPattern& pattern() const { return pattern_; }
 

@@ -1,0 +1,45 @@
+#include "solvers/mass_solve.hpp"
+
+namespace rfem {
+
+bool solve_mass(const Model& model, const BorderedPattern& pattern, const std::vector<int>& base_col,
+                const VecX& q, const VecX& v, VecX& b, std::vector<double>& values) {
+  MatrixTerms mt;
+  mt.mass = 1.0;
+  assemble_matrix(model, pattern, base_col, q, v, mt, values);
+  const int n = pattern.n_rfes(), nb = pattern.n_base(), n6 = 6 * n;
+  auto entry = [&](int r, int c) { return values[pattern.slot(std::min(r, c), std::max(r, c))]; };
+  MatX S(nb, nb);  // Schur complement on the free joints
+  for (int i = 0; i < nb; ++i)
+    for (int j = 0; j < nb; ++j) S(i, j) = entry(n6 + i, n6 + j);
+  VecX rb = b.tail(nb);
+  std::vector<Eigen::LLT<Mat6>> llt(n);
+  for (int k = 0; k < n; ++k) {
+    Mat6 Mkk;
+    Eigen::Matrix<double, 6, Eigen::Dynamic> B(6, nb);
+    for (int i = 0; i < 6; ++i) {
+      for (int j = 0; j < 6; ++j) Mkk(i, j) = entry(6 * k + i, 6 * k + j);
+      for (int j = 0; j < nb; ++j) B(i, j) = entry(6 * k + i, n6 + j);
+    }
+    llt[k].compute(Mkk);
+    if (llt[k].info() != Eigen::Success) return false;
+    if (nb > 0) {
+      S.noalias() -= B.transpose() * llt[k].solve(B);
+      rb.noalias() -= B.transpose() * llt[k].solve(b.segment<6>(6 * k));
+    }
+  }
+  if (nb > 0) {
+    Eigen::LLT<MatX> sl(S);
+    if (sl.info() != Eigen::Success) return false;
+    b.tail(nb) = sl.solve(rb);
+  }
+  for (int k = 0; k < n; ++k) {
+    Vec6 rhs = b.segment<6>(6 * k);
+    for (int j = 0; j < nb; ++j)
+      for (int i = 0; i < 6; ++i) rhs[i] -= entry(6 * k + i, n6 + j) * b[n6 + j];
+    b.segment<6>(6 * k) = llt[k].solve(rhs);
+  }
+  return true;
+}
+
+}  // namespace rfem
