@@ -89,27 +89,6 @@ std::vector<JointInput> joint_inputs(const Case& cs) {
 
 namespace {
 
-// Force input reproducing the rigid manipulator's inverse dynamics of the given laws (paper step 2).
-std::vector<JointInput> rigid_torque_inputs(const Model& rigid, const std::vector<JointInput>& laws) {
-  std::vector<JointInput> out(laws.size());
-  for (size_t j = 0; j < laws.size(); ++j) {
-    out[j].q0 = laws[j].q0;
-    out[j].v0 = laws[j].v0;
-    out[j].torque = torque_function([&rigid, laws, j](double t) {
-      const int m = rigid.m();
-      VecX q(m), v(m), a(m), F;
-      for (int i = 0; i < m; ++i) {
-        const MotionSample s = laws[i].motion->at(t);
-        q[i] = s.q;
-        v[i] = s.qd;
-        a[i] = s.qdd;
-      }
-      generalised_forces(rigid, q, v, a, ForceTerms{}, F);
-      return F[static_cast<long>(j)];
-    });
-  }
-  return out;
-}
 
 RunSummary run_one(ResultsFile& file, const std::string& name, const Model& model, const std::vector<JointInput>& inputs,
                    const Case& cs, bool quiet, const Observer& observe) {
@@ -183,6 +162,28 @@ RunSummary run_one(ResultsFile& file, const std::string& name, const Model& mode
 }
 
 }  // namespace
+
+// Force input reproducing the rigid manipulator's inverse dynamics of the given laws (paper step 2).
+std::vector<JointInput> rigid_torque_inputs(const Model& rigid, const std::vector<JointInput>& laws) {
+  std::vector<JointInput> out(laws.size());
+  for (size_t j = 0; j < laws.size(); ++j) {
+    out[j].q0 = laws[j].q0;
+    out[j].v0 = laws[j].v0;
+    out[j].torque = torque_function([&rigid, laws, j](double t) {
+      const int m = rigid.m();
+      VecX q(m), v(m), a(m), F;
+      for (int i = 0; i < m; ++i) {
+        const MotionSample s = laws[i].motion->at(t);
+        q[i] = s.q;
+        v[i] = s.qd;
+        a[i] = s.qdd;
+      }
+      generalised_forces(rigid, q, v, a, ForceTerms{}, F);
+      return F[static_cast<long>(j)];
+    });
+  }
+  return out;
+}
 
 std::atomic<int>& stop_flag() { return g_stop; }
 

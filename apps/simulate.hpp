@@ -23,6 +23,10 @@ using Observer = std::function<void(const std::string& run, const Model& model, 
 /// The joints' inputs of a case (reads tabulated files and earlier results; CaseError if bad).
 std::vector<JointInput> joint_inputs(const Case& cs);
 
+/// Force input reproducing the rigid manipulator's inverse dynamics of the given motion laws,
+/// evaluated exactly at every time (the paper's step 2). `rigid` must outlive the inputs.
+std::vector<JointInput> rigid_torque_inputs(const Model& rigid, const std::vector<JointInput>& laws);
+
 /// Runs the case's procedure on `model`, writing groups `prefix + run name` into `file`.
 std::vector<RunSummary> simulate_case(const Case& cs, const Model& model, const std::vector<JointInput>& inputs,
                                       ResultsFile& file, const std::string& prefix, bool quiet,
