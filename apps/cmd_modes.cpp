@@ -18,38 +18,61 @@ bool has_exact_reference(const Case& cs, const VecX& vb) {
 }  // namespace
 
 int run_modes(const Common& c, const ModesOptions& o) {
-  const Case cs = read_case(c.case_path, c.overrides);
+  const Case cs = read_checked_case(c);
   const Model model = build_model(cs, c.n);
   if (model.n() == 0) throw CaseError(cs.path + ": link: modal analysis needs a flexible link");
   VecX qb, vb;
   joint_state(cs, o, qb, vb);
   const int count = std::min(o.count, 6 * model.n());
+  if (o.count > count && !c.json)
+    fmt::print(stderr, "rfem: note: --count {} capped at 6n = {} (every mode of n = {} rfes)\n", o.count, count, model.n());
   const ModesResult r = compute_modes(model, qb, vb, count);
   const bool exact = has_exact_reference(cs, vb);
   int seen[4] = {0, 0, 0, 0};
   nlohmann::json modes = nlohmann::json::array();
+  // References for one uniform segment: the theory the discretisation converges to (Timoshenko for
+  // bending: shear and rotary inertia are in the rfes and sdes; rod theory for axial and torsion
+  // modes), and the Euler–Bernoulli value beside it for bending.
   if (!c.json)
-    fmt::print("modes of {} with n = {} rfes ({} solver){}\n{:>4} {:>14} {:>14} {:>10}{}\n",
+    fmt::print("modes of {} with n = {} rfes ({} solver){}\n{:>4} {:>14} {:>14} {:>12}{}\n",
                cs.name.empty() ? cs.path : cs.name, model.n(), r.dense ? "dense" : "shift-invert Lanczos",
                vb.size() && vb.norm() > 0 ? fmt::format(", joint rates {}", fmt::join(vb.data(), vb.data() + vb.size(), " ")) : "",
-               "mode", "f [Hz]", "omega [rad/s]", "kind", exact ? fmt::format(" {:>14} {:>10}", "exact [Hz]", "error") : "");
+               "mode", "f [Hz]", "omega [rad/s]", "kind",
+               exact ? fmt::format(" {:>16} {:>10} {:>16}", "reference [Hz]", "error", "Euler-Bern. [Hz]") : "");
   for (int i = 0; i < count; ++i) {
     const double f = r.omega[i] / (2 * M_PI);
     const int k = ++seen[static_cast<int>(r.kind[i])];
     nlohmann::json jm = {{"mode", i + 1}, {"frequency_hz", f}, {"omega", r.omega[i]}, {"kind", to_string(r.kind[i])},
-                         {"index_of_kind", k}};
+                         {"index_of_kind", k}, {"residual", r.residual[i]}};
     std::string extra;
     if (exact) {
-      const double fe = beam::cantilever_omega(cs.link.segments[0], r.kind[i], k) / (2 * M_PI);
-      jm["exact_hz"] = fe;
-      jm["relative_error"] = (f - fe) / fe;
-      extra = fmt::format(" {:>14.6f} {:>+9.4f}%", fe, 100.0 * (f - fe) / fe);
+      const Segment& sg = cs.link.segments[0];
+      const bool bending = r.kind[i] == ModeKind::BendingY || r.kind[i] == ModeKind::BendingZ;
+      const double fr = (bending ? beam::cantilever_omega_timoshenko(sg, r.kind[i], k) : beam::cantilever_omega(sg, r.kind[i], k)) /
+                        (2 * M_PI);
+      jm["reference_hz"] = fr;
+      jm["reference_theory"] = bending ? "Timoshenko" : "rod";
+      jm["relative_error"] = (f - fr) / fr;
+      std::string eb = "-";
+      if (bending) {
+        const double fe = beam::cantilever_omega(sg, r.kind[i], k) / (2 * M_PI);
+        jm["euler_bernoulli_hz"] = fe;
+        eb = fmt::format("{:.6f}", fe);
+      }
+      extra = fmt::format(" {:>11.6f} {:<4} {:>+9.4f}% {:>16}", fr, bending ? "(T)" : "(rod)", 100.0 * (f - fr) / fr, eb);
     }
     modes.push_back(jm);
     if (!c.json)
-      fmt::print("{:>4} {:>14.6f} {:>14.6f} {:>10}{}\n", i + 1, f, r.omega[i],
+      fmt::print("{:>4} {:>14.6f} {:>14.6f} {:>12}{}\n", i + 1, f, r.omega[i],
                  fmt::format("{}{}", to_string(r.kind[i]), k), extra);
   }
+  for (int i = 0; i < count; ++i)
+    if (r.residual[i] > kResidualTolerance)
+      fmt::print(stderr, "rfem: warning: mode {}: the eigen-solution lost digits (relative residual {:.1e} > {:.0e}); "
+                 "fewer rfes give more accurate frequencies\n", i + 1, r.residual[i], kResidualTolerance);
+  if (!c.json && exact)
+    fmt::print("reference: (T) Timoshenko cantilever (shear and rotary inertia), (rod) rod theory; the error is "
+               "the discretisation's and falls as 1/n²\n");
   if (c.json) print_json({{"command", "modes"}, {"case", cs.path}, {"n", model.n()}, {"solver", r.dense ? "dense" : "lanczos"},
                           {"modes", modes}});
   return 0;

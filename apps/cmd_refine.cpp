@@ -1,3 +1,7 @@
+// `rfem refine`: quantities over a series of n. Every quantity is checked before the first run;
+// dynamic quantities share one simulation per n; the finest n is run again at tighter tolerances
+// to estimate the integration error; solvers/refinement.hpp says what the series can be trusted
+// for. Ctrl-C keeps (and prints) the rows done so far.
 #include <fmt/core.h>
 
 #include <cctype>
@@ -6,33 +10,58 @@
 
 #include "apps/simulate.hpp"
 #include "solvers/modes.hpp"
+#include "solvers/refinement.hpp"
 #include "solvers/statics.hpp"
 
 namespace rfem::app {
 
-double evaluate_quantity(const Case& cs, int n, const std::string& quantity, const ModesOptions& o) {
+namespace {
+
+// A static or modal quantity: "tip:ux|uy|uz|rx|ry|rz", "mode:K", "axial:K", "bending-y:K",
+// "bending-z:K", "torsion:K".
+struct StaticQuantity {
+  std::string what;
+  int index = 0;  // tip component 0..5, or mode K ≥ 1
+};
+
+StaticQuantity parse_static(const std::string& quantity) {
+  const auto colon = quantity.find(':');
+  StaticQuantity s;
+  s.what = quantity.substr(0, colon);
+  const std::string arg = colon == std::string::npos ? "" : quantity.substr(colon + 1);
+  if (s.what == "tip") {
+    static const char* names[6] = {"ux", "uy", "uz", "rx", "ry", "rz"};
+    for (int i = 0; i < 6; ++i)
+      if (arg == names[i]) {
+        s.index = i;
+        return s;
+      }
+    throw CaseError("--quantity " + quantity + ": tip component must be ux, uy, uz, rx, ry or rz");
+  }
+  if (s.what != "mode" && s.what != "axial" && s.what != "bending-y" && s.what != "bending-z" && s.what != "torsion")
+    throw CaseError("--quantity " + quantity + ": unknown quantity '" + s.what +
+                    "' (tip:ux…rz, mode:K, axial:K, bending-y:K, bending-z:K, torsion:K, [RUN/]peak:u1|u2|theta, "
+                    "[RUN/]u1@T, u2@T, theta@T, tauJ@T, qJ@T)");
+  size_t used = 0;
+  try {
+    s.index = std::stoi(arg, &used);
+  } catch (...) {
+    used = 0;
+  }
+  if (used == 0 || used != arg.size() || s.index < 1)
+    throw CaseError("--quantity " + quantity + ": expected " + s.what + ":K with an integer K ≥ 1");
+  return s;
+}
+
+double evaluate_static(const Case& cs, int n, const StaticQuantity& s, const std::string& quantity, const ModesOptions& o) {
   const Model model = build_model(cs, n);
   VecX qb, vb;
   joint_state(cs, o, qb, vb);
-  const auto colon = quantity.find(':');
-  const std::string what = quantity.substr(0, colon), arg = colon == std::string::npos ? "" : quantity.substr(colon + 1);
-  if (what == "tip") {
-    static const char* names[6] = {"ux", "uy", "uz", "rx", "ry", "rz"};
-    for (int i = 0; i < 6; ++i)
-      if (arg == names[i]) return tip_motion(model, solve_static(model, qb, vb, cs.loads).q)[i];
-    throw CaseError("--quantity " + quantity + ": tip component must be ux, uy, uz, rx, ry or rz");
-  }
-  int k = 0;
-  try {
-    k = std::stoi(arg);
-  } catch (...) {
-    k = 0;
-  }
-  if (k < 1) throw CaseError("--quantity " + quantity + ": expected NAME:K with K ≥ 1");
-  if (what != "mode" && what != "axial" && what != "bending-y" && what != "bending-z" && what != "torsion")
-    throw CaseError("--quantity " + quantity + ": unknown quantity '" + what + "'");
-  if (what == "mode") {
-    if (k > 6 * model.n()) throw CaseError("--quantity " + quantity + ": n = " + std::to_string(n) + " has only " + std::to_string(6 * model.n()) + " modes");
+  if (s.what == "tip") return tip_motion(model, solve_static(model, qb, vb, cs.loads).q)[s.index];
+  const int k = s.index;
+  if (s.what == "mode") {
+    if (k > 6 * model.n())
+      throw CaseError("--quantity " + quantity + ": n = " + std::to_string(n) + " has only " + std::to_string(6 * model.n()) + " modes");
     return compute_modes(model, qb, vb, k).omega[k - 1] / (2 * M_PI);
   }
   // Modes of one kind can sit high in the spectrum (axial modes of a slender beam): widen the
@@ -41,28 +70,27 @@ double evaluate_quantity(const Case& cs, int n, const std::string& quantity, con
     const ModesResult r = compute_modes(model, qb, vb, count);
     int seen = 0;
     for (int i = 0; i < count; ++i)
-      if (to_string(r.kind[i]) == what && ++seen == k) return r.omega[i] / (2 * M_PI);
+      if (to_string(r.kind[i]) == s.what && ++seen == k) return r.omega[i] / (2 * M_PI);
     if (count == 6 * model.n()) break;
   }
-  const int count = 6 * model.n();
-  throw std::runtime_error("--quantity " + quantity + ": no such mode among all " + std::to_string(count) +
+  throw std::runtime_error("--quantity " + quantity + ": no such mode among all " + std::to_string(6 * model.n()) +
                            " at n = " + std::to_string(n));
 }
 
-namespace {
-
 // A dynamic quantity "[RUN/]peak:u1|u2|theta", "[RUN/]u1@T", "u2@T", "theta@T", "tauJ@T", "qJ@T"
-// (J 1-based). Returns false if `quantity` is not dynamic.
+// (J 1-based).
 struct DynamicQuantity {
   std::string run, what;
   double time = -1.0;  // < 0: peak over the run
   int joint = -1;
 };
 
+// Returns false if `quantity` is not dynamic; throws CaseError if it is but cannot be evaluated.
 bool parse_dynamic(const Case& cs, const std::string& quantity, DynamicQuantity& d) {
   std::string q = quantity;
   const auto slash = q.find('/');
-  d.run = cs.sim.procedure == "paper" ? "kinematic" : "run";
+  const bool paper = cs.sim.procedure == "paper";
+  d.run = paper ? "kinematic" : "run";
   if (slash != std::string::npos) {
     d.run = q.substr(0, slash);
     q = q.substr(slash + 1);
@@ -71,12 +99,16 @@ bool parse_dynamic(const Case& cs, const std::string& quantity, DynamicQuantity&
     d.what = q.substr(5);
   } else if (const auto at = q.find('@'); at != std::string::npos) {
     d.what = q.substr(0, at);
+    size_t used = 0;
     try {
-      d.time = std::stod(q.substr(at + 1));
+      d.time = std::stod(q.substr(at + 1), &used);
     } catch (...) {
-      throw CaseError("--quantity " + quantity + ": '" + q.substr(at + 1) + "' is not a time");
+      used = 0;
     }
+    if (used == 0 || used != q.size() - at - 1 || !std::isfinite(d.time))
+      throw CaseError("--quantity " + quantity + ": '" + q.substr(at + 1) + "' is not a time");
   } else {
+    if (slash != std::string::npos) throw CaseError("--quantity " + quantity + ": expected RUN/peak:X or RUN/X@T");
     return false;
   }
   if (d.what.rfind("tau", 0) == 0 || (d.what.size() > 1 && d.what[0] == 'q' && std::isdigit(d.what[1]))) {
@@ -89,113 +121,214 @@ bool parse_dynamic(const Case& cs, const std::string& quantity, DynamicQuantity&
     throw CaseError("--quantity " + quantity + ": expected u1, u2, theta, tauJ or qJ");
   }
   if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: a dynamic quantity needs a [simulation] table");
+  const bool known = paper ? (d.run == "rigid" || d.run == "kinematic" || d.run == "force") : d.run == "run";
+  if (!known)
+    throw CaseError("--quantity " + quantity + ": no run named '" + d.run + "' (" +
+                    (paper ? "the paper procedure runs rigid, kinematic and force" : "a single run is named run") + ")");
+  const IntegratorOptions& o = cs.sim.options;
+  if (d.time >= 0) {
+    const double k = std::round(d.time / o.output_dt);
+    const bool on_grid = std::abs(d.time - k * o.output_dt) <= 1e-9 * std::max(1.0, d.time) || d.time == o.t_end;
+    if (d.time > o.t_end * (1 + 1e-12) || !on_grid)
+      throw CaseError("--quantity " + quantity + ": t = " + fmt::format("{}", d.time) + " s is not an output time (0 … " +
+                      fmt::format("{}", o.t_end) + " s every " + fmt::format("{}", o.output_dt) + " s)");
+  }
   return true;
 }
 
-double evaluate_dynamic(const Case& cs, const std::vector<JointInput>& inputs, int n, const DynamicQuantity& d,
-                        ResultsFile& file, bool quiet) {
+struct Quantity {
+  std::string text;
+  bool dynamic = false;
+  StaticQuantity s;
+  DynamicQuantity d;
+};
+
+// One simulation at n: every dynamic quantity observed in it.
+std::vector<double> evaluate_dynamic(const Case& cs, const std::vector<JointInput>& inputs, int n,
+                                     const std::vector<Quantity>& qs, ResultsFile* file, const std::string& prefix,
+                                     int threads) {
+  // (file is never null: refine opens one whenever a quantity is dynamic)
   const Model model = build_model(cs, n);
-  const std::string prefix = fmt::format("n{}/", n);  // (fmt: GCC 12 warns falsely on "n" + to_string)
-  double value = d.time < 0 ? 0.0 : NAN, best_dt = 1e300;
+  std::vector<double> value(qs.size(), NAN), best_dt(qs.size(), 1e300);
+  for (size_t i = 0; i < qs.size(); ++i)
+    if (qs[i].dynamic && qs[i].d.time < 0) value[i] = 0.0;
   auto observe = [&](const std::string& run, const Model& m, const OutputSample& s) {
-    if (run != prefix + d.run) return;
-    double x = 0.0;
-    if (d.what == "tau") x = s.tau[d.joint - 1];
-    else if (d.what == "q") x = s.q[6 * m.n() + d.joint - 1];
-    else x = tip_deflection(m, s.q)[d.what == "u1" ? 0 : d.what == "u2" ? 1 : 2];
-    if (d.time < 0) value = std::max(value, std::abs(x));
-    else if (std::abs(s.t - d.time) < best_dt) best_dt = std::abs(s.t - d.time), value = x;
+    for (size_t i = 0; i < qs.size(); ++i) {
+      const DynamicQuantity& d = qs[i].d;
+      if (!qs[i].dynamic || run != prefix + d.run) continue;
+      double x = 0.0;
+      if (d.what == "tau") x = s.tau[d.joint - 1];
+      else if (d.what == "q") x = s.q[m.base_index(d.joint - 1)];
+      else x = tip_deflection(m, s.q)[d.what == "u1" ? 0 : d.what == "u2" ? 1 : 2];
+      if (d.time < 0) value[i] = std::max(value[i], std::abs(x));
+      else if (std::abs(s.t - d.time) < best_dt[i]) best_dt[i] = std::abs(s.t - d.time), value[i] = x;
+    }
   };
-  const auto runs = simulate_case(cs, model, inputs, file, prefix, quiet, observe);
-  bool seen = false;
-  for (const auto& r : runs) {
-    if (!r.completed) throw std::runtime_error("n = " + std::to_string(n) + ": " + r.name + " " + r.status);
-    seen |= r.name == prefix + d.run;
-  }
-  if (!seen) throw CaseError("--quantity: no run named '" + d.run + "' (runs: rigid, kinematic, force or run)");
-  if (d.time >= 0 && best_dt > 1e-9 * std::max(1.0, d.time))
-    throw CaseError("--quantity: t = " + std::to_string(d.time) + " s is not an output time (output_dt = " +
-                    std::to_string(cs.sim.output_dt) + " s)");
+  const auto runs = simulate_case(cs, model, inputs, *file, prefix, true, observe, threads);
+  for (const auto& r : runs)
+    if (!r.completed) {
+      if (stop_flag().load()) return {};
+      throw std::runtime_error("n = " + std::to_string(n) + ": " + r.name + " " + r.status);
+    }
   return value;
 }
 
-void write_table(ResultsFile& file, const std::string& quantity, const std::vector<int>& ns, const std::vector<double>& val,
-                 const std::vector<double>& change, const std::vector<double>& order, const std::vector<double>& extrap) {
+void put(hid_t g, const char* name, const std::vector<double>& v) {
+  const hsize_t dims[1] = {v.size()};
+  const hid_t sp = H5Screate_simple(1, dims, nullptr);
+  const hid_t ds = H5Dcreate2(g, name, H5T_NATIVE_DOUBLE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  if (!v.empty()) H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
+  H5Dclose(ds);
+  H5Sclose(sp);
+}
+
+// Group `refine`: n and, per quantity, refine/q<k> with value, change, order, richardson and its
+// assessment; the first quantity's datasets also directly in `refine`.
+void write_table(ResultsFile& file, const std::vector<Quantity>& qs, const std::vector<int>& ns,
+                 const std::vector<Refinement>& tables, const std::string& status) {
+  if (H5Lexists(file.id(), "refine", H5P_DEFAULT) > 0) H5Ldelete(file.id(), "refine", H5P_DEFAULT);
   const hid_t g = H5Gcreate2(file.id(), "refine", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-  auto put = [&](const char* name, const std::vector<double>& v) {
-    const hsize_t dims[1] = {v.size()};
-    const hid_t sp = H5Screate_simple(1, dims, nullptr);
-    const hid_t ds = H5Dcreate2(g, name, H5T_NATIVE_DOUBLE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
-    H5Dclose(ds);
-    H5Sclose(sp);
-  };
-  put("n", std::vector<double>(ns.begin(), ns.end()));
-  put("value", val);
-  put("change", change);
-  put("order", order);
-  put("richardson", extrap);
-  write_attribute(g, "quantity", quantity);
-  if (std::isfinite(extrap.back())) write_attribute(g, "reference", extrap.back());
+  put(g, "n", std::vector<double>(ns.begin(), ns.end()));
+  write_attribute(g, "status", status);
+  write_attribute(g, "quantities", static_cast<double>(qs.size()));
+  for (size_t k = 0; k < qs.size(); ++k) {
+    const Refinement& t = tables[k];
+    std::vector<double> val, change, order, rich;
+    for (const auto& r : t.rows) {
+      val.push_back(r.value);
+      change.push_back(r.change);
+      order.push_back(r.order);
+      rich.push_back(r.richardson);
+    }
+    const hid_t q = H5Gcreate2(g, ("q" + std::to_string(k)).c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    for (hid_t where : {q, k == 0 ? g : hid_t(-1)}) {
+      if (where < 0) continue;
+      put(where, "value", val);
+      put(where, "change", change);
+      put(where, "order", order);
+      put(where, "richardson", rich);
+      write_attribute(where, "quantity", qs[k].text);
+      write_attribute(where, "fitted_order", t.fitted_order);
+      write_attribute(where, "integration_error", t.integration_error);
+      std::string w;
+      for (const auto& x : t.warnings) w += (w.empty() ? "" : "\n") + x;
+      write_attribute(where, "warnings", w);
+      if (std::isfinite(t.reference())) write_attribute(where, "reference", t.reference());
+    }
+    H5Gclose(q);
+  }
   H5Gclose(g);
   file.flush();
 }
 
+void print_tables(const Case& cs, const std::vector<Quantity>& qs, const std::vector<Refinement>& tables) {
+  auto opt = [](double x, const char* f) { return std::isfinite(x) ? fmt::format(fmt::runtime(f), x) : std::string("-"); };
+  for (size_t k = 0; k < qs.size(); ++k) {
+    const Refinement& t = tables[k];
+    fmt::print("refinement of {} for {}\n{:>6} {:>20} {:>14} {:>8} {:>20}\n", cs.name.empty() ? cs.path : cs.name, qs[k].text,
+               "n", "value", "change", "order", "Richardson");
+    for (const auto& r : t.rows)
+      fmt::print("{:>6} {:>20.12e} {:>14} {:>8} {:>20}\n", r.n, r.value, opt(r.change, "{:.3e}"), opt(r.order, "{:.3f}"),
+                 opt(r.richardson, "{:.12e}"));
+    fmt::print("fitted order (least squares over all changes): {}", opt(t.fitted_order, "{:.3f}"));
+    if (std::isfinite(t.integration_error)) fmt::print("; integration error at n = {}: {:.3e}", t.rows.back().n, t.integration_error);
+    fmt::print("\n");
+  }
+}
+
 }  // namespace
 
-int run_refine(const Common& c, const std::vector<int>& ns, const std::string& quantity, const ModesOptions& o,
-               const std::string& output) {
-  const Case cs = read_case(c.case_path, c.overrides);
-  DynamicQuantity dq;
-  const bool dynamic = parse_dynamic(cs, quantity, dq);
+double evaluate_quantity(const Case& cs, int n, const std::string& quantity, const ModesOptions& o) {
+  return evaluate_static(cs, n, parse_static(quantity), quantity, o);
+}
+
+int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) {
+  const Case cs = read_checked_case(c);
+  if (ro.quantities.empty()) throw CaseError("--quantity: give at least one quantity (see rfem refine --help)");
+  if (ro.ns.size() < 2) throw CaseError("--n: refine needs at least two values");
+  for (size_t i = 1; i < ro.ns.size(); ++i)
+    if (ro.ns[i] <= ro.ns[i - 1])
+      throw CaseError("--n: the values must increase (" + std::to_string(ro.ns[i - 1]) + " then " + std::to_string(ro.ns[i]) + ")");
+  // Every quantity and every n are checked before the first run.
+  std::vector<Quantity> qs;
+  bool dynamic = false;
+  for (const auto& text : ro.quantities) {
+    Quantity q;
+    q.text = text;
+    q.dynamic = parse_dynamic(cs, text, q.d);
+    if (!q.dynamic) q.s = parse_static(text);
+    dynamic |= q.dynamic;
+    qs.push_back(q);
+  }
+  for (int n : ro.ns) build_model(cs, n);  // an impossible discretisation fails here
   std::unique_ptr<ResultsFile> file;
   const std::vector<JointInput> inputs = dynamic ? joint_inputs(cs) : std::vector<JointInput>{};
-  if (dynamic || !output.empty()) {
-    std::string path = output;
+  if (dynamic || !ro.output.empty()) {
+    std::string path = ro.output;
     if (path.empty()) {
       const std::string stem = cs.path.substr(cs.path.find_last_of('/') + 1);
       path = stem.substr(0, stem.rfind('.')) + "_refine.h5";
     }
     file = std::make_unique<ResultsFile>(path);
-    file->attribute("rfem_version", RFEM_VERSION_STRING);
-    file->attribute("case_path", cs.path);
-    file->attribute("case_text", cs.text);
-    file->attribute("procedure", std::string("refine"));
-    install_signal_handlers();
+    describe_run(*file, cs, c, "refine");
   }
+  if (dynamic) check_affordable(cs, build_model(cs, ro.ns.back()), inputs, c.threads, c.json || c.quiet);
+  install_signal_handlers();
   const bool quiet = c.json || c.quiet;
-  std::vector<double> val(ns.size()), change(ns.size(), NAN), order(ns.size(), NAN), extrap(ns.size(), NAN);
-  for (size_t i = 0; i < ns.size(); ++i) {
-    if (!quiet && dynamic) fmt::print(stderr, "[{}/{}] n = {}\n", i + 1, ns.size(), ns[i]);
-    val[i] = dynamic ? evaluate_dynamic(cs, inputs, ns[i], dq, *file, true) : evaluate_quantity(cs, ns[i], quantity, o);
-    if (dynamic && stop_flag().load()) return 128 + stop_flag().load();
-    if (i >= 1) change[i] = val[i] - val[i - 1];
-    // Observed order from three successive values: p = ln(|Δ_{i−1}| / |Δ_i|) / ln(n_i / n_{i−1}).
-    if (i >= 2 && change[i] != 0.0 && change[i - 1] != 0.0) {
-      order[i] = std::log(std::abs(change[i - 1] / change[i])) / std::log(double(ns[i]) / ns[i - 1]);
-      const double r = std::pow(double(ns[i]) / ns[i - 1], order[i]);
-      extrap[i] = val[i] + change[i] / (r - 1.0);
+  std::vector<int> done;
+  std::vector<std::vector<double>> values(qs.size());
+  std::string status = "completed";
+  for (size_t i = 0; i < ro.ns.size(); ++i) {
+    const int n = ro.ns[i];
+    if (!quiet) fmt::print(stderr, "[{}/{}] n = {}\n", i + 1, ro.ns.size(), n);
+    std::vector<double> dyn;
+    if (dynamic) dyn = evaluate_dynamic(cs, inputs, n, qs, file.get(), fmt::format("n{}/", n), c.threads);
+    if (stop_flag().load()) {
+      status = fmt::format("interrupted (signal {})", stop_flag().load());
+      break;
     }
+    for (size_t k = 0; k < qs.size(); ++k)
+      values[k].push_back(qs[k].dynamic ? dyn[k] : evaluate_static(cs, n, qs[k].s, qs[k].text, o));
+    done.push_back(n);
   }
-  if (file) write_table(*file, quantity, ns, val, change, order, extrap);
+  // The integration error of the finest run: the same n at tolerances 100 times tighter.
+  std::vector<double> integration(qs.size(), NAN);
+  if (dynamic && ro.integration_check && status == "completed") {
+    if (!quiet) fmt::print(stderr, "[check] n = {} at rtol {:g}\n", done.back(), cs.sim.options.rtol / 100);
+    Case tight = cs;
+    tight.sim.options.rtol /= 100;
+    tight.sim.options.atol /= 100;
+    tight.sim.options.max_steps *= 100;
+    const auto ref = evaluate_dynamic(tight, inputs, done.back(), qs, file.get(), fmt::format("check_n{}/", done.back()), c.threads);
+    if (stop_flag().load()) status = fmt::format("interrupted (signal {})", stop_flag().load());
+    else
+      for (size_t k = 0; k < qs.size(); ++k)
+        if (qs[k].dynamic) integration[k] = std::abs(values[k].back() - ref[k]);
+  }
+  std::vector<Refinement> tables;
+  for (size_t k = 0; k < qs.size(); ++k) tables.push_back(assess_refinement(done, values[k], integration[k]));
+  if (file) write_table(*file, qs, done, tables, status);
+  for (size_t k = 0; k < qs.size(); ++k)  // warnings always reach stderr, with --json and --quiet too
+    for (const auto& w : tables[k].warnings) fmt::print(stderr, "rfem: warning: {}: {}\n", qs[k].text, w);
+  const int code = stop_flag().load() ? 128 + stop_flag().load() : 0;
   if (c.json) {
-    nlohmann::json rows = nlohmann::json::array();
     auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
-    for (size_t i = 0; i < ns.size(); ++i)
-      rows.push_back({{"n", ns[i]}, {"value", val[i]}, {"change", num(change[i])}, {"order", num(order[i])},
-                      {"richardson", num(extrap[i])}});
-    print_json({{"command", "refine"}, {"case", cs.path}, {"quantity", quantity}, {"rows", rows},
+    nlohmann::json jq = nlohmann::json::array();
+    for (size_t k = 0; k < qs.size(); ++k) {
+      nlohmann::json rows = nlohmann::json::array();
+      for (const auto& r : tables[k].rows)
+        rows.push_back({{"n", r.n}, {"value", r.value}, {"change", num(r.change)}, {"order", num(r.order)},
+                        {"richardson", num(r.richardson)}});
+      jq.push_back({{"quantity", qs[k].text}, {"rows", rows}, {"fitted_order", num(tables[k].fitted_order)},
+                    {"integration_error", num(tables[k].integration_error)}, {"warnings", tables[k].warnings}});
+    }
+    print_json({{"command", "refine"}, {"case", cs.path}, {"status", status}, {"quantities", jq},
                 {"output", file ? file->path() : ""}});
-    return 0;
+    return code;
   }
-  fmt::print("refinement of {} for {}\n{:>6} {:>20} {:>14} {:>8} {:>20}\n", cs.name.empty() ? cs.path : cs.name, quantity,
-             "n", "value", "change", "order", "Richardson");
-  auto opt = [](double x, const char* f) { return std::isfinite(x) ? fmt::format(fmt::runtime(f), x) : std::string("-"); };
-  for (size_t i = 0; i < ns.size(); ++i)
-    fmt::print("{:>6} {:>20.12e} {:>14} {:>8} {:>20}\n", ns[i], val[i], opt(change[i], "{:.3e}"), opt(order[i], "{:.3f}"),
-               opt(extrap[i], "{:.12e}"));
-  if (file) fmt::print("every run and the table in {}\n", file->path());
-  return 0;
+  print_tables(cs, qs, tables);
+  if (file) fmt::print("every run and the table in {}{}\n", file->path(), status == "completed" ? "" : " (" + status + ")");
+  return code;
 }
 
 }  // namespace rfem::app

@@ -6,24 +6,20 @@
 namespace rfem::app {
 
 int run_simulation(const Common& c, const std::string& output) {
-  const Case cs = read_case(c.case_path, c.overrides);
+  const Case cs = read_checked_case(c);
   if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: missing table (t_end, output_dt, …) for `rfem run`");
   if (cs.joints.empty()) throw CaseError(cs.path + ": joints: `rfem run` needs at least one base joint");
   const Model model = build_model(cs, c.n);
   const std::vector<JointInput> inputs = joint_inputs(cs);  // bad inputs fail before any file is written
+  check_affordable(cs, model, inputs, c.threads, c.json || c.quiet);
   install_signal_handlers();
   ResultsFile file(output);
-  file.attribute("rfem_version", RFEM_VERSION_STRING);
-  file.attribute("case_path", cs.path);
-  file.attribute("case_text", cs.text);
-  file.attribute("procedure", cs.sim.procedure);
-  write_attribute(file.id(), "n", static_cast<double>(model.n()));
-  write_attribute(file.id(), "threads", static_cast<double>(omp_get_max_threads()));
+  describe_run(file, cs, c, cs.sim.procedure, model.n());
   const bool quiet = c.json || c.quiet;
   if (!quiet)
     fmt::print("rfem run {}: n = {} rfes, m = {} joints, t_end = {} s, {} thread(s) -> {}\n", cs.path, model.n(),
-               model.m(), cs.sim.t_end, omp_get_max_threads(), output);
-  const std::vector<RunSummary> runs = simulate_case(cs, model, inputs, file, "", quiet);
+               model.m(), cs.sim.options.t_end, omp_get_max_threads(), output);
+  const std::vector<RunSummary> runs = simulate_case(cs, model, inputs, file, "", quiet, {}, c.threads);
   const RunSummary& last = runs.back();
   if (c.json) {
     nlohmann::json js = nlohmann::json::array();

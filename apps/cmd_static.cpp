@@ -6,12 +6,12 @@
 
 namespace rfem::app {
 
-int run_static(const Common& c) {
-  const Case cs = read_case(c.case_path, c.overrides);
+int run_static(const Common& c, const ModesOptions& o) {
+  const Case cs = read_checked_case(c);
   const Model model = build_model(cs, c.n);
   if (model.n() == 0) throw CaseError(cs.path + ": link: static analysis needs a flexible link");
   VecX qb, vb;
-  joint_state(cs, ModesOptions{}, qb, vb);
+  joint_state(cs, o, qb, vb);
   const StaticResult r = solve_static(model, qb, vb, cs.loads);
   const Vec6 tip = tip_motion(model, r.q);
   const Energies E = energies(model, r.q, VecX::Zero(model.dof()));

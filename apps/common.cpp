@@ -7,6 +7,12 @@ namespace rfem::app {
 
 void print_json(const nlohmann::json& j) { fmt::print("{}\n", j.dump(2)); }
 
+Case read_checked_case(const Common& c) {
+  Case cs = read_case(c.case_path, c.overrides);
+  for (const auto& w : cs.warnings) fmt::print(stderr, "rfem: warning: {}\n", w);
+  return cs;
+}
+
 void joint_state(const Case& cs, const ModesOptions& o, VecX& qb, VecX& vb) {
   qb = cs.joint_values;
   vb = cs.joint_rates;

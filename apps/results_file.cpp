@@ -6,16 +6,49 @@
 
 namespace rfem::app {
 
+namespace {
+// Variable-length UTF-8: h5py reads these as str (fixed-length ASCII comes back as bytes).
+hid_t string_type() {
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  H5Tset_size(type, H5T_VARIABLE);
+  H5Tset_cset(type, H5T_CSET_UTF8);
+  return type;
+}
+}  // namespace
+
 void write_attribute(hid_t obj, const std::string& key, const std::string& value) {
   if (H5Aexists(obj, key.c_str()) > 0) H5Adelete(obj, key.c_str());
-  const hid_t type = H5Tcopy(H5T_C_S1);
-  H5Tset_size(type, std::max<size_t>(1, value.size()));
+  const hid_t type = string_type();
   const hid_t space = H5Screate(H5S_SCALAR);
   const hid_t attr = H5Acreate2(obj, key.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT);
-  H5Awrite(attr, type, value.c_str());
+  const char* p = value.c_str();
+  H5Awrite(attr, type, &p);
   H5Aclose(attr);
   H5Sclose(space);
   H5Tclose(type);
+}
+
+void write_attribute(hid_t obj, const std::string& key, const std::vector<std::string>& values) {
+  if (H5Aexists(obj, key.c_str()) > 0) H5Adelete(obj, key.c_str());
+  const hid_t type = string_type();
+  const hsize_t dims[1] = {values.size()};
+  const hid_t space = H5Screate_simple(1, dims, nullptr);
+  const hid_t attr = H5Acreate2(obj, key.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT);
+  std::vector<const char*> p;
+  for (const auto& v : values) p.push_back(v.c_str());
+  H5Awrite(attr, type, p.data());
+  H5Aclose(attr);
+  H5Sclose(space);
+  H5Tclose(type);
+}
+
+void write_attribute(hid_t obj, const std::string& key, long value) {
+  if (H5Aexists(obj, key.c_str()) > 0) H5Adelete(obj, key.c_str());
+  const hid_t space = H5Screate(H5S_SCALAR);
+  const hid_t attr = H5Acreate2(obj, key.c_str(), H5T_NATIVE_LONG, space, H5P_DEFAULT, H5P_DEFAULT);
+  H5Awrite(attr, H5T_NATIVE_LONG, &value);
+  H5Aclose(attr);
+  H5Sclose(space);
 }
 
 void write_attribute(hid_t obj, const std::string& key, double value) {
@@ -27,16 +60,60 @@ void write_attribute(hid_t obj, const std::string& key, double value) {
   H5Sclose(space);
 }
 
+namespace {
+hid_t latest_fapl() {  // SWMR needs the latest file format
+  const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+  H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+  return fapl;
+}
+}  // namespace
+
 ResultsFile::ResultsFile(const std::string& path) : path_(path) {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported by us, once
-  file_ = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-  if (file_ < 0) throw std::runtime_error(path + ": cannot create results file");
+  const hid_t fapl = latest_fapl();
+  file_ = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+  H5Pclose(fapl);
+  if (file_ < 0) throw std::runtime_error(path + ": cannot create results file (is the directory writable?)");
 }
 ResultsFile::~ResultsFile() {
+  if (swmr_) end_swmr();
   if (file_ >= 0) H5Fclose(file_);
 }
-void ResultsFile::attribute(const std::string& key, const std::string& value) { write_attribute(file_, key, value); }
+void ResultsFile::attribute(const std::string& key, const std::string& value) { attribute("/", key, Value(value)); }
 void ResultsFile::flush() { H5Fflush(file_, H5F_SCOPE_GLOBAL); }
+
+void ResultsFile::attribute(const std::string& path, const std::string& key, const Value& value) {
+  if (swmr_) {
+    pending_.push_back({path, key, value});
+    return;
+  }
+  const hid_t obj = H5Oopen(file_, path.c_str(), H5P_DEFAULT);
+  if (obj < 0) return;
+  std::visit([&](const auto& v) { write_attribute(obj, key, v); }, value);
+  H5Oclose(obj);
+}
+
+void ResultsFile::begin_swmr() {
+  if (swmr_) return;
+  H5Fflush(file_, H5F_SCOPE_GLOBAL);
+  swmr_ = H5Fstart_swmr_write(file_) >= 0;
+}
+
+void ResultsFile::end_swmr() {
+  if (!swmr_) return;
+  H5Fclose(file_);
+  // Readers that watched the run (SWMR, shared locks) may still have the file open: reopen without
+  // file locks for the attributes and the next run's group (a watcher reopens to see them).
+  const hid_t fapl = latest_fapl();
+  H5Pset_file_locking(fapl, false, true);
+  file_ = H5Fopen(path_.c_str(), H5F_ACC_RDWR, fapl);
+  H5Pclose(fapl);
+  swmr_ = false;
+  if (file_ < 0) throw std::runtime_error(path_ + ": cannot reopen the results file");
+  for (const auto& p : pending_) attribute(p.path, p.key, p.value);
+  pending_.clear();
+  flush();
+}
 
 Eigen::Vector3d tip_deflection(const Model& model, const VecX& q) {
   const Vec6 t = tip_motion(model, q);
@@ -44,41 +121,105 @@ Eigen::Vector3d tip_deflection(const Model& model, const VecX& q) {
 }
 
 RunGroup::RunGroup(ResultsFile& file, const std::string& name, const Model& model, int flexible_every)
-    : file_(file), model_(model), flexible_every_(flexible_every), last_flush_(std::chrono::steady_clock::now()) {
+    : file_(file), model_(model), name_(name), flexible_every_(flexible_every), last_flush_(std::chrono::steady_clock::now()) {
+  if (file.swmr()) file.end_swmr();  // a new group: not while another run's SWMR lasts
   const hid_t lcpl = H5Pcreate(H5P_LINK_CREATE);  // "n60/kinematic" creates "n60" as needed
   H5Pset_create_intermediate_group(lcpl, 1);
   group_ = H5Gcreate2(file.id(), name.c_str(), lcpl, H5P_DEFAULT, H5P_DEFAULT);
   H5Pclose(lcpl);
   if (group_ < 0) throw std::runtime_error(file.path() + ": cannot create group " + name);
-  const int m = model.m();
-  std::string joints;
-  for (const auto& j : model.joints) joints += (joints.empty() ? "" : ",") + j.name;
-  add_series("time", 1, "t [s]");
-  add_series("joint_q", m, joints);
-  add_series("joint_v", m, joints);
-  add_series("joint_a", m, joints);
-  add_series("joint_tau", m, joints);
-  add_series("tip", 6, "ux,uy,uz [m],rx,ry,rz [rad] in {r}");
-  add_series("tip_deflection", 3, "u1 (along y of {r}) [m],u2 (along z) [m],theta (torsion) [rad]");
-  add_series("energy", 6, "kinetic,elastic,gravity,input_work,dissipated,balance [J]");
-  if (flexible_every_ > 0 && model.n() > 0) {
-    add_series("flexible_time", 1, "t [s]");
-    add_series("flexible_q", 6 * model.n(), "rfe k: x1,x2,x3,phi1,phi2,phi3 for k = 1..n");
+  const int m = model.m(), n = model.n();
+  std::vector<std::string> jn, jt, ju, rate, acc, tau;
+  for (const auto& j : model.joints) {
+    const bool rev = j.type == JointType::Revolute;
+    jn.push_back(j.name);
+    jt.push_back(rev ? "revolute" : "prismatic");
+    ju.push_back(rev ? "rad" : "m");
+    rate.push_back(rev ? "rad/s" : "m/s");
+    acc.push_back(rev ? "rad/s^2" : "m/s^2");
+    tau.push_back(rev ? "N m" : "N");
   }
-  write_attribute(group_, "n", static_cast<double>(model.n()));
-  write_attribute(group_, "m", static_cast<double>(m));
-  write_attribute(group_, "joints", joints);
+  add_series("time", {"t"}, {"s"});
+  add_series("joint_q", jn, ju, "joint coordinates");
+  add_series("joint_v", jn, rate, "joint rates");
+  add_series("joint_a", jn, acc, "joint accelerations (of the integrator's continuous solution)");
+  add_series("joint_tau", jn, tau, "applied torque/force (force input) or required (kinematic input)");
+  add_series("tip", {"ux", "uy", "uz", "rx", "ry", "rz"}, {"m", "m", "m", "rad", "rad", "rad"},
+             "free end on the elastic axis: displacement from undeformed and rotation φ of rfe_n, in {r} axes");
+  add_series("tip_position", {"x", "y", "z"}, {"m", "m", "m"}, "free end on the elastic axis, in the inertial frame {0}");
+  add_series("tip_deflection", {"u1", "u2", "theta"}, {"m", "m", "rad"},
+             "the paper's tip deflections: u1 along y of {r}, u2 along z of {r}, theta the torsion phi1 of rfe_n");
+  add_series("energy", {"kinetic", "elastic", "gravity", "input_work", "dissipated", "balance"},
+             {"J", "J", "J", "J", "J", "J"}, "balance = kinetic + elastic + gravity + dissipated - input_work");
+  if (flexible_every_ > 0 && n > 0) {
+    add_series("flexible_time", {"t"}, {"s"});
+    std::vector<std::string> cols, units;
+    for (int k = 1; k <= n; ++k)
+      for (const char* c : {"x1", "x2", "x3", "phi1", "phi2", "phi3"}) {
+        cols.push_back("rfe" + std::to_string(k) + "." + c);
+        units.push_back(c[0] == 'x' ? "m" : "rad");
+      }
+    add_series("flexible_q", cols, units,
+               "rfe coordinates [2.2]: mass-centre displacement from rfe_centre and angles of R = RotY(phi2) "
+               "RotZ(phi3) RotX(phi1), in {r} axes");
+  }
+  if (n > 0) {  // the undeformed mass centres in {r}: flexible_q is relative to these
+    const hsize_t dims[2] = {static_cast<hsize_t>(n), 3};
+    const hid_t sp = H5Screate_simple(2, dims, nullptr);
+    const hid_t d = H5Dcreate2(group_, "rfe_centre", H5T_NATIVE_DOUBLE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    std::vector<double> c;
+    for (const auto& r : model.link.rfes) c.insert(c.end(), {r.centre[0], r.centre[1], r.centre[2]});
+    H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, c.data());
+    write_attribute(d, "columns", std::vector<std::string>{"x", "y", "z"});
+    write_attribute(d, "units", std::vector<std::string>{"m", "m", "m"});
+    write_attribute(d, "description", std::string("undeformed mass centre of rfe k (row k-1) in {r}"));
+    H5Dclose(d);
+    H5Sclose(sp);
+  }
+  {  // the live status: a fixed-size string, writable while the file is in SWMR mode
+    const hid_t type = H5Tcopy(H5T_C_S1);
+    H5Tset_size(type, 256);
+    const hid_t sp = H5Screate(H5S_SCALAR);
+    status_ = H5Dcreate2(group_, "status_now", type, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    H5Sclose(sp);
+    H5Tclose(type);
+  }
+  write_attribute(group_, "n", static_cast<long>(n));
+  write_attribute(group_, "m", static_cast<long>(m));
+  write_attribute(group_, "joint_names", jn);
+  write_attribute(group_, "joint_types", jt);
+  write_attribute(group_, "joint_units", ju);
   write_attribute(group_, "status", std::string("running"));
+  status("running");
+  file.begin_swmr();
 }
 
-RunGroup::~RunGroup() {
+RunGroup::~RunGroup() { close(); }
+
+void RunGroup::close() {
+  if (group_ < 0) return;
   flush();
   for (auto& [k, s] : series_) H5Dclose(s.dset);
+  series_.clear();
+  if (status_ >= 0) H5Dclose(status_);
   H5Gclose(group_);
+  group_ = status_ = -1;
 }
 
-void RunGroup::add_series(const std::string& name, int cols, const std::string& columns) {
-  const hsize_t dims[2] = {0, static_cast<hsize_t>(std::max(cols, 1))};
+void RunGroup::status(const std::string& s) {
+  if (status_ < 0) return;
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  H5Tset_size(type, 256);
+  char buf[256] = {0};
+  s.copy(buf, 255);
+  H5Dwrite(status_, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
+  H5Tclose(type);
+}
+
+void RunGroup::add_series(const std::string& name, const std::vector<std::string>& columns,
+                          const std::vector<std::string>& units, const std::string& description) {
+  const int cols = std::max<int>(1, static_cast<int>(columns.size()));
+  const hsize_t dims[2] = {0, static_cast<hsize_t>(cols)};
   const hsize_t maxd[2] = {H5S_UNLIMITED, dims[1]};
   const hid_t space = H5Screate_simple(2, dims, maxd);
   const hid_t plist = H5Pcreate(H5P_DATASET_CREATE);
@@ -87,8 +228,10 @@ void RunGroup::add_series(const std::string& name, int cols, const std::string& 
   const hid_t d = H5Dcreate2(group_, name.c_str(), H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, plist, H5P_DEFAULT);
   H5Pclose(plist);
   H5Sclose(space);
-  write_attribute(d, "columns", columns);
-  series_[name] = Series{d, std::max(cols, 1)};
+  write_attribute(d, "columns", columns.empty() ? std::vector<std::string>{"(none)"} : columns);
+  write_attribute(d, "units", units.empty() ? std::vector<std::string>{""} : units);
+  if (!description.empty()) write_attribute(d, "description", description);
+  series_[name] = Series{d, cols};
 }
 
 void RunGroup::write_row(const std::string& name, long row, const double* data) {
@@ -119,6 +262,8 @@ void RunGroup::append(const OutputSample& s) {
   }
   const Vec6 tip = tip_motion(model_, s.q);
   write_row("tip", rows_, tip.data());
+  const Vec3 p = tip_position(model_, s.q);
+  write_row("tip_position", rows_, p.data());
   const Eigen::Vector3d u = tip_deflection(model_, s.q);
   write_row("tip_deflection", rows_, u.data());
   const double total = s.energy.kinetic + s.energy.elastic + s.energy.gravity;
@@ -131,13 +276,19 @@ void RunGroup::append(const OutputSample& s) {
     ++flex_rows_;
   }
   ++rows_;
-  // Flush at most twice a second: output must not dominate a run, yet little is lost on a crash.
+  // Flush at most twice a second: output must not dominate a run, yet little is lost on a crash
+  // and a watching reader sees the run advance.
   if (std::chrono::steady_clock::now() - last_flush_ > std::chrono::milliseconds(500)) flush();
 }
 
-void RunGroup::attribute(const std::string& key, const std::string& value) { write_attribute(group_, key, value); }
-void RunGroup::attribute(const std::string& key, double value) { write_attribute(group_, key, value); }
+void RunGroup::attribute(const std::string& key, const std::string& value) { file_.attribute(name_, key, value); }
+void RunGroup::attribute(const std::string& key, double value) { file_.attribute(name_, key, value); }
+void RunGroup::attribute(const std::string& key, long value) { file_.attribute(name_, key, value); }
 void RunGroup::flush() {
+  if (group_ < 0) return;
+  if (file_.swmr())
+    for (auto& [k, s] : series_) H5Dflush(s.dset);
+  if (status_ >= 0 && file_.swmr()) H5Dflush(status_);
   file_.flush();
   last_flush_ = std::chrono::steady_clock::now();
 }

@@ -10,65 +10,111 @@
 
 #include "apps/commands.hpp"
 
+namespace {
+
+// Positive integers only, with a message that says so (CLI11's range check prints the largest
+// double). Runs on the text, before any conversion.
+const CLI::Validator kPositiveInt(
+    [](std::string& s) -> std::string {
+      size_t used = 0;
+      long v = 0;
+      try {
+        v = std::stol(s, &used);
+      } catch (...) {
+        used = 0;
+      }
+      if (used == 0 || used != s.size() || v < 1 || v > 100000000)
+        return "must be a positive integer (got '" + s + "')";
+      return "";
+    },
+    "POSITIVE");
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace rfem::app;
   CLI::App app{"rfem: dynamics of manipulators with flexible links by the Rigid Finite Element Method"};
   app.set_version_flag("--version", std::string("rfem ") + RFEM_VERSION);
   app.require_subcommand(1);
+  app.fallthrough();  // global options (--threads) also after the subcommand
   Common common;
-  app.add_option("--threads", common.threads, "OpenMP threads for assembly (default: all cores)")
-      ->check(CLI::PositiveNumber);
-  auto add_common = [&](CLI::App* sub) {
+  for (int i = 0; i < argc; ++i) common.command_line += (i ? " " : "") + std::string(argv[i]);
+  app.add_option("--threads", common.threads,
+                 "OpenMP threads (default: all cores, each run timing one thread against all and keeping the faster)")
+      ->check(kPositiveInt);
+  auto add_common = [&](CLI::App* sub, bool single_n) {
     sub->add_option("case", common.case_path, "case file (TOML)")->required();
     sub->add_option("--set", common.overrides, "override a case value: key.path=value (repeatable)");
-    sub->add_option("--n", common.n, "number of rfes, distributed over the segments by length")
-        ->check(CLI::PositiveNumber);
+    if (single_n)
+      sub->add_option("--n", common.n, "number of rfes, distributed over the segments by length")->check(kPositiveInt);
     sub->add_flag("--json", common.json, "print results as JSON");
     sub->add_flag("-q,--quiet", common.quiet, "no progress line or summary");
     sub->add_flag("-v,--verbose", common.verbose, "log solver events to stderr");
   };
   ModesOptions mo;
   auto add_rate = [&](CLI::App* sub) {
-    sub->add_option("--rate", mo.rate, "steady rate of the chosen joint [rad/s]")->each([&](const std::string&) {
+    sub->add_option("--rate", mo.rate, "steady rate of the chosen joint [rad/s or m/s]")->each([&](const std::string&) {
       mo.rate_given = true;
     });
-    sub->add_option("--joint", mo.joint, "joint (1-based) that --rate applies to")->check(CLI::PositiveNumber);
+    sub->add_option("--joint", mo.joint, "joint (1-based) that --rate applies to")->check(kPositiveInt);
   };
 
-  auto* st = app.add_subcommand("static", "static equilibrium under gravity and tip loads, joints held");
-  add_common(st);
+  auto* st = app.add_subcommand("static", "static equilibrium under gravity and tip loads, joints held (or turning steadily: --rate)");
+  add_common(st, true);
+  add_rate(st);
   auto* md = app.add_subcommand("modes", "natural frequencies and mode shapes of the flexible link, base held");
-  add_common(md);
-  md->add_option("--count", mo.count, "number of modes")->check(CLI::PositiveNumber);
+  add_common(md, true);
+  md->add_option("--count", mo.count, "number of modes (at most 6n)")->check(kPositiveInt);
   add_rate(md);
   auto* rn = app.add_subcommand("run", "time integration of the case's [simulation]; results to HDF5");
-  add_common(rn);
+  add_common(rn, true);
   std::string output;
   rn->add_option("-o,--output", output, "results file (default: the case name with .h5, here)");
   auto* pl = app.add_subcommand("plot", "PNG figures of a results file (the paper's Figures 5-8, runs, refinement)");
   std::string plot_file, plot_dir;
   pl->add_option("results", plot_file, "results file (HDF5) from rfem run or rfem refine")->required();
   pl->add_option("-o,--output", plot_dir, "directory for the PNG files (default: beside the results file)");
-  auto* rf = app.add_subcommand("refine", "convergence table of a quantity over a series of n");
-  add_common(rf);
-  std::string ns_text = "5,10,20,40,80", quantity = "mode:1";
-  rf->add_option("--ns", ns_text, "comma-separated list of n (alias of --n for refine)");
-  rf->add_option("--quantity", quantity,
-                 "static tip:ux|uy|uz|rx|ry|rz; modes mode:K, bending-y:K, bending-z:K, axial:K, torsion:K; "
-                 "dynamic [RUN/]peak:u1|u2|theta, [RUN/]u1@T, u2@T, theta@T, tauJ@T, qJ@T");
-  std::string refine_output;
-  rf->add_option("-o,--output", refine_output, "HDF5 file for every run and the table (default for dynamic quantities: CASE_refine.h5)");
+  auto* rf = app.add_subcommand("refine", "convergence tables of quantities over a series of n");
+  add_common(rf, false);
+  RefineOptions ro;
+  rf->add_option("--n", ro.ns, "the series of n, increasing: --n 6,12,24")->delimiter(',')->check(kPositiveInt)->required();
+  rf->add_option("--quantity", ro.quantities,
+                 "one or more (comma-separated, from the same runs): static tip:ux|uy|uz|rx|ry|rz; modes mode:K, "
+                 "bending-y:K, bending-z:K, axial:K, torsion:K; dynamic [RUN/]peak:u1|u2|theta, [RUN/]u1@T, u2@T, "
+                 "theta@T, tauJ@T, qJ@T")
+      ->delimiter(',')
+      ->required();
+  rf->add_option("-o,--output", ro.output, "HDF5 file for every run and the tables (default for dynamic quantities: CASE_refine.h5)");
+  bool no_check = false;
+  rf->add_flag("--no-integration-check", no_check,
+               "do not rerun the finest n at 100x tighter tolerances to estimate the integration error");
   add_rate(rf);
-  // refine takes a list in --n: reroute it before parsing.
-  for (int i = 1; i + 1 < argc; ++i)
-    if (std::string(argv[i]) == "refine")
-      for (int k = i + 1; k + 1 < argc; ++k)
-        if (std::string(argv[k]) == "--n") argv[k] = const_cast<char*>("--ns");
 
+  // A first word that is neither an option nor a command (CLI11 would only say one is required).
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::string w = argv[1];
+    bool known = false;
+    for (const auto* sub : app.get_subcommands([](const CLI::App*) { return true; })) known |= sub->get_name() == w;
+    if (!known) {
+      fmt::print(stderr, "rfem: error: unknown command '{}' (static, modes, run, refine, plot; rfem --help)\n", w);
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // The README's rule for bad input: one line, exit code 2.
+    std::string what = e.what();
+    for (char& ch : what)
+      if (ch == '\n') ch = ' ';
+    fmt::print(stderr, "rfem: error: {} (rfem --help)\n", what);
+    return 2;
   }
   if (common.threads > 0) omp_set_num_threads(common.threads);
   Eigen::setNbThreads(1);  // we parallelise ourselves
@@ -76,7 +122,7 @@ int main(int argc, char** argv) {
   spdlog::set_pattern("[%H:%M:%S.%e] %v");
   spdlog::set_level(common.verbose ? spdlog::level::debug : spdlog::level::warn);
   try {
-    if (st->parsed()) return run_static(common);
+    if (st->parsed()) return run_static(common, mo);
     if (md->parsed()) return run_modes(common, mo);
     if (pl->parsed()) return run_plot(plot_file, plot_dir);
     if (rn->parsed()) {
@@ -87,18 +133,8 @@ int main(int argc, char** argv) {
       return run_simulation(common, output);
     }
     if (rf->parsed()) {
-      std::vector<int> ns;
-      std::stringstream ss(ns_text);
-      for (std::string t; std::getline(ss, t, ',');) {
-        try {
-          ns.push_back(std::stoi(t));
-        } catch (...) {
-          throw rfem::CaseError("--n: '" + t + "' is not an integer");
-        }
-        if (ns.back() < 1) throw rfem::CaseError("--n: every n must be positive");
-      }
-      if (ns.size() < 2) throw rfem::CaseError("--n: refine needs at least two values");
-      return run_refine(common, ns, quantity, mo, refine_output);
+      ro.integration_check = !no_check;
+      return run_refine(common, ro, mo);
     }
   } catch (const rfem::CaseError& e) {
     fmt::print(stderr, "rfem: error: {}\n", e.what());

@@ -1,4 +1,5 @@
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
@@ -18,8 +19,9 @@ namespace {
 std::atomic<int> g_stop{0};
 extern "C" void on_signal(int sig) { g_stop.store(sig); }
 
-// Joint torques of an earlier run: dataset joint_tau of group `run`, column `joint`.
-std::shared_ptr<TorqueLaw> torque_from_results(const InputSpec& in, int joint) {
+// Joint torques of an earlier run: dataset joint_tau of group `run`, column `joint`, as a cubic
+// spline through the output samples (error O(Δt⁴)); the run must reach this case's t_end.
+std::shared_ptr<TorqueLaw> torque_from_results(const InputSpec& in, int joint, double t_end) {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   const hid_t f = H5Fopen(in.file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   if (f < 0) throw CaseError(in.where + ".file: '" + in.file + "' is not a readable HDF5 results file");
@@ -40,14 +42,39 @@ std::shared_ptr<TorqueLaw> torque_from_results(const InputSpec& in, int joint) {
   std::vector<double> t, tau;
   hsize_t rt = 0, ct = 0, rj = 0, cj = 0;
   const bool ok = read("time", t, rt, ct) && read("joint_tau", tau, rj, cj);
+  std::string status = "unknown";
+  if (ok) {  // the source's status attribute (variable-length string)
+    const hid_t g = H5Oopen(f, in.run.c_str(), H5P_DEFAULT);
+    if (g >= 0 && H5Aexists(g, "status") > 0) {
+      const hid_t a = H5Aopen(g, "status", H5P_DEFAULT);
+      const hid_t type = H5Aget_type(a);
+      if (H5Tis_variable_str(type) > 0) {
+        char* p = nullptr;
+        if (H5Aread(a, type, &p) >= 0 && p) {
+          status = p;
+          H5free_memory(p);
+        }
+      }
+      H5Tclose(type);
+      H5Aclose(a);
+    }
+    if (g >= 0) H5Oclose(g);
+  }
   H5Fclose(f);
   if (!ok) throw CaseError(in.where + ".run: no run '" + in.run + "' with time and joint_tau in '" + in.file + "'");
   const int col = (in.joint > 0 ? in.joint : joint + 1) - 1;
   if (col >= static_cast<int>(cj)) throw CaseError(in.where + ".joint: the run has " + std::to_string(cj) + " joints");
+  t.resize(rt);
+  if (rt < 3) throw CaseError(in.where + ": the run '" + in.run + "' in '" + in.file + "' has fewer than 3 output steps");
+  if (t_end > t.back() * (1 + 1e-12) + 1e-12)
+    throw CaseError(in.where + ": the run '" + in.run + "' in '" + in.file + "' ends at t = " + fmt::format("{}", t.back()) +
+                    " s (" + status + "), before simulation.t_end = " + fmt::format("{}", t_end) + " s");
+  if (status != "completed")
+    fmt::print(stderr, "rfem: warning: {}: the source run '{}' did not complete ({}); its torques are used up to t = {} s\n",
+               in.where, in.run, status, t.back());
   std::vector<double> v(rj);
   for (hsize_t i = 0; i < rj; ++i) v[i] = tau[i * cj + col];
-  t.resize(rt);
-  return tabulated_torque(t, v);
+  return spline_torque(t, v);
 }
 
 }  // namespace
@@ -73,7 +100,9 @@ std::vector<JointInput> joint_inputs(const Case& cs) {
         std::vector<double> t, tau;
         read_csv_series(in.file, t, tau);
         ji.torque = tabulated_torque(t, tau);
-      } else if (in.kind == "torque_from_run") ji.torque = torque_from_results(in, static_cast<int>(j));
+      } else if (in.kind == "torque_from_run") {
+        ji.torque = torque_from_results(in, static_cast<int>(j), cs.has_simulation ? cs.sim.options.t_end : 0.0);
+      }
     } catch (const CaseError&) {
       throw;
     } catch (const std::exception& e) {
@@ -91,20 +120,13 @@ namespace {
 
 
 RunSummary run_one(ResultsFile& file, const std::string& name, const Model& model, const std::vector<JointInput>& inputs,
-                   const Case& cs, bool quiet, const Observer& observe) {
-  Progress progress(name, cs.sim.t_end, quiet);
+                   const Case& cs, bool quiet, const Observer& observe, int threads) {
+  Progress progress(name, cs.sim.options.t_end, quiet);
   RunSummary s;
   s.name = name;
   RunGroup group(file, name, model, cs.sim.flexible_every);
-  IntegratorOptions o;
-  o.t_end = cs.sim.t_end;
-  o.output_dt = cs.sim.output_dt;
-  o.rtol = cs.sim.rtol;
-  o.atol = cs.sim.atol;
-  o.atol_velocity = cs.sim.atol_velocity;
-  o.max_step = cs.sim.max_step;
-  o.max_order = cs.sim.max_order;
-  o.max_steps = cs.sim.max_steps;
+  IntegratorOptions o = cs.sim.options;
+  o.parallel.threads = threads;
   double balance0 = NAN;
   const auto t0 = std::chrono::steady_clock::now();
   const RunOutcome r = integrate(
@@ -138,18 +160,23 @@ RunSummary run_one(ResultsFile& file, const std::string& name, const Model& mode
   group.attribute("atol", o.atol);
   group.attribute("atol_velocity", o.atol_velocity);
   group.attribute("max_step", o.max_step);
-  group.attribute("max_order", static_cast<double>(o.max_order));
+  group.attribute("integrator", integrator_name(o.kind));
+  if (o.kind == IntegratorKind::Esdirk) group.attribute("method", o.esdirk_table);
+  else group.attribute("max_order", static_cast<long>(o.max_order));
   group.attribute("output_dt", o.output_dt);
-  group.attribute("threads", static_cast<double>(omp_get_max_threads()));
-  group.attribute("steps", static_cast<double>(r.stats.steps));
-  group.attribute("residual_evals", static_cast<double>(r.stats.residual_evals));
-  group.attribute("factorizations", static_cast<double>(r.stats.factorizations));
-  group.attribute("newton_iters", static_cast<double>(r.stats.newton_iters));
-  group.attribute("newton_fails", static_cast<double>(r.stats.newton_fails));
-  group.attribute("error_test_fails", static_cast<double>(r.stats.error_test_fails));
-  std::string kinds;
-  for (const auto& in : inputs) kinds += std::string(kinds.empty() ? "" : ",") + (in.prescribed() ? "motion" : "torque");
-  group.attribute("inputs", kinds);
+  group.attribute("threads", static_cast<long>(omp_get_max_threads()));
+  group.attribute("steps", static_cast<long>(r.stats.steps));
+  group.attribute("residual_evals", static_cast<long>(r.stats.residual_evals));
+  group.attribute("factorizations", static_cast<long>(r.stats.factorizations));
+  group.attribute("newton_iters", static_cast<long>(r.stats.newton_iters));
+  group.attribute("newton_fails", static_cast<long>(r.stats.newton_fails));
+  group.attribute("error_test_fails", static_cast<long>(r.stats.error_test_fails));
+  std::vector<std::string> kinds;
+  for (const auto& in : inputs) kinds.push_back(in.prescribed() ? "motion" : "torque");
+  group.attribute("inputs", fmt::format("{}", fmt::join(kinds, ",")));
+  group.status(r.status);
+  group.close();
+  file.end_swmr();  // writes the attributes queued above
   if (!quiet)
     fmt::print("{:<10} {}: t = {:.3f} s, {} outputs, wall {:.3f} s; steps {}, residuals {}, factorisations {}, "
                "Newton iterations {} (failures {}), error-test failures {}\n"
@@ -161,6 +188,17 @@ RunSummary run_one(ResultsFile& file, const std::string& name, const Model& mode
   return s;
 }
 
+}  // namespace
+
+namespace {
+std::vector<double> all_breakpoints(const std::vector<JointInput>& laws) {
+  std::vector<double> b;
+  for (const auto& l : laws) {
+    const auto x = l.breakpoints();
+    b.insert(b.end(), x.begin(), x.end());
+  }
+  return b;
+}
 }  // namespace
 
 // Force input reproducing the rigid manipulator's inverse dynamics of the given laws (paper step 2).
@@ -180,12 +218,59 @@ std::vector<JointInput> rigid_torque_inputs(const Model& rigid, const std::vecto
       }
       generalised_forces(rigid, q, v, a, ForceTerms{}, F);
       return F[static_cast<long>(j)];
-    });
+    }, all_breakpoints(laws));
   }
   return out;
 }
 
 std::atomic<int>& stop_flag() { return g_stop; }
+
+void describe_run(ResultsFile& file, const Case& cs, const Common& c, const std::string& procedure, int n) {
+  file.attribute("rfem_version", RFEM_VERSION_STRING);
+  file.attribute("build", RFEM_BUILD_DESCRIPTION);
+  file.attribute("command_line", c.command_line);
+  file.attribute("case_path", cs.path);
+  file.attribute("case_text", cs.text);
+  file.attribute("case_effective", cs.effective_text);
+  std::string ov;
+  for (const auto& o : cs.overrides) ov += (ov.empty() ? "" : "\n") + o;
+  file.attribute("overrides", ov);
+  file.attribute("procedure", procedure);
+  if (n >= 0) write_attribute(file.id(), "n", static_cast<long>(n));
+  write_attribute(file.id(), "threads", static_cast<long>(omp_get_max_threads()));
+}
+
+namespace {
+// MemAvailable of /proc/meminfo [B]; infinity where it cannot be read.
+double available_memory() {
+  std::FILE* f = std::fopen("/proc/meminfo", "r");
+  if (!f) return INFINITY;
+  char line[256];
+  double kb = INFINITY;
+  while (std::fgets(line, sizeof line, f))
+    if (std::sscanf(line, "MemAvailable: %lf kB", &kb) == 1) break;
+  std::fclose(f);
+  return kb * 1024.0;
+}
+}  // namespace
+
+void check_affordable(const Case& cs, const Model& model, const std::vector<JointInput>& inputs, int threads,
+                      bool quiet) {
+  IntegratorOptions o = cs.sim.options;
+  o.parallel.threads = threads;
+  const RunEstimate e0 = estimate_run(model, inputs, o, false);
+  const double avail = available_memory();
+  if (e0.bytes > avail)
+    throw CaseError(fmt::format("{}: link.n: a run with n = {} rfes needs about {:.2g} GB of memory, {:.2g} GB are available",
+                                cs.path, model.n(), e0.bytes / 1e9, avail / 1e9));
+  if (model.n() < kLargeRunRfes || quiet) return;
+  const RunEstimate e = estimate_run(model, inputs, o, true);
+  fmt::print(stderr,
+             "rfem: note: n = {} rfes: about {:.0f} MB of memory; one residual evaluation {:.3g} ms, one Newton "
+             "matrix {:.3g} ms, so about {:.2g} s per step (the shipped cases take 400 to 6000 steps at the "
+             "default tolerances)\n",
+             model.n(), e.bytes / 1e6, e.residual_s * 1e3, e.newton_setup_s * 1e3, e.step_s());
+}
 
 void install_signal_handlers() {
   std::signal(SIGINT, on_signal);
@@ -193,19 +278,20 @@ void install_signal_handlers() {
 }
 
 std::vector<RunSummary> simulate_case(const Case& cs, const Model& model, const std::vector<JointInput>& inputs,
-                                      ResultsFile& file, const std::string& prefix, bool quiet, const Observer& observe) {
+                                      ResultsFile& file, const std::string& prefix, bool quiet, const Observer& observe,
+                                      int threads) {
   std::vector<RunSummary> runs;
   if (cs.sim.procedure == "paper") {
     for (size_t j = 0; j < inputs.size(); ++j)
       if (!inputs[j].prescribed())
         throw CaseError(cs.inputs[j].where + ": the paper procedure needs a motion law on every joint");
     const Model rigid = rigidify(model);
-    runs.push_back(run_one(file, prefix + "rigid", rigid, inputs, cs, quiet, observe));
-    if (runs.back().completed) runs.push_back(run_one(file, prefix + "kinematic", model, inputs, cs, quiet, observe));
+    runs.push_back(run_one(file, prefix + "rigid", rigid, inputs, cs, quiet, observe, threads));
+    if (runs.back().completed) runs.push_back(run_one(file, prefix + "kinematic", model, inputs, cs, quiet, observe, threads));
     if (runs.back().completed)
-      runs.push_back(run_one(file, prefix + "force", model, rigid_torque_inputs(rigid, inputs), cs, quiet, observe));
+      runs.push_back(run_one(file, prefix + "force", model, rigid_torque_inputs(rigid, inputs), cs, quiet, observe, threads));
   } else {
-    runs.push_back(run_one(file, prefix + "run", model, inputs, cs, quiet, observe));
+    runs.push_back(run_one(file, prefix + "run", model, inputs, cs, quiet, observe, threads));
   }
   file.flush();
   return runs;

@@ -28,9 +28,21 @@ std::vector<JointInput> joint_inputs(const Case& cs);
 std::vector<JointInput> rigid_torque_inputs(const Model& rigid, const std::vector<JointInput>& laws);
 
 /// Runs the case's procedure on `model`, writing groups `prefix + run name` into `file`.
+/// `threads` > 0 fixes the kernels' team size (--threads); 0 lets each run choose by timing.
 std::vector<RunSummary> simulate_case(const Case& cs, const Model& model, const std::vector<JointInput>& inputs,
                                       ResultsFile& file, const std::string& prefix, bool quiet,
-                                      const Observer& observe = {});
+                                      const Observer& observe = {}, int threads = 0);
+
+/// Before a run of `model`: refuses (CaseError naming link.n) a run whose estimated memory
+/// (solvers/integrator.hpp, estimate_run) exceeds the memory available now; from kLargeRunRfes
+/// rfes on prints a note with the memory and the timed cost of a step (unless quiet).
+void check_affordable(const Case& cs, const Model& model, const std::vector<JointInput>& inputs, int threads,
+                      bool quiet);
+
+/// File attributes that let a results file describe its own run: rfem_version, build,
+/// command_line, case_path, case_text (the file as read), case_effective (after --set), overrides,
+/// procedure, n (when fixed for the file), threads.
+void describe_run(ResultsFile& file, const Case& cs, const Common& c, const std::string& procedure, int n = -1);
 
 /// SIGINT/SIGTERM set the stop flag: runs end cleanly after the current step.
 void install_signal_handlers();

@@ -7,21 +7,20 @@
 
 namespace rfem {
 
+int Parallelism::team(int n) const {
+  if (n < min_rfes) return 1;
+  return threads > 0 ? threads : omp_get_max_threads();
+}
+
+int Workspace::chunks(int n) {
+  const int c = (n + parallel.chunk - 1) / parallel.chunk;
+  moments.assign(c, BaseMoments{});
+  power.assign(c, 0.0);
+  boundary.assign(c, Vec6::Zero());
+  return c;
+}
+
 namespace {
-
-constexpr int kChunk = 64;  // rfes per reduction chunk (fixed: thread-count independent sums)
-int g_parallel_min = 256;  // below this many rfes a parallel region costs more than it saves
-
-struct BaseMoments {  // Σ over bodies of Y = W H Ẅᵀ, G = W H Wᵀ, s = W H e₄
-  Mat4 Y = Mat4::Zero(), G = Mat4::Zero();
-  Vec4 s = Vec4::Zero();
-  BaseMoments& operator+=(const BaseMoments& o) {
-    Y += o.Y;
-    G += o.G;
-    s += o.s;
-    return *this;
-  }
-};
 
 // rfe_0's rotation (zero coordinates): R = I, ∂R/∂φ the generators.
 const RfeRotation& clamp_rotation() {
@@ -31,6 +30,12 @@ const RfeRotation& clamp_rotation() {
     return rfe_rotation(d);
   }();
   return r;
+}
+
+RfeRotation rotation_of(const Vec6& q) {
+  DeformationTransform d;
+  deformation_transform(q, d, false);
+  return rfe_rotation(d);
 }
 
 Vec3 left_centre(const Discretisation& d, const Sde& e) {
@@ -62,185 +67,227 @@ void base_kin(const Model& model, const VecX& q, const VecX& v, const VecX& a, B
 
 }  // namespace
 
-void set_parallel_min_rfes(int n) { g_parallel_min = n; }
-
 void generalised_forces(const Model& model, const VecX& q, const VecX& v, const VecX& a,
-                        const ForceTerms& terms, VecX& F) {
+                        const ForceTerms& terms, VecX& F, double* dissipation, Workspace* wsp) {
+  Workspace local;
+  Workspace& ws = wsp ? *wsp : local;
   const int n = model.n(), m = model.m();
   const Discretisation& d = model.link;
-  const double g = terms.gravity ? model.gravity : 0.0;
-  F.setZero(model.dof());
-  const VecX zero_v = terms.velocity_products ? VecX() : VecX::Zero(model.dof());
-  const VecX& vi = terms.velocity_products ? v : zero_v;  // velocity seen by the inertial terms
-  BaseKinematics bk;
+  const double g = terms.gravity ? model.gravity : 0.0, beta = d.damping_beta;
+  F.resize(model.dof());
+  if (!terms.velocity_products && ws.zero.size() != model.dof()) ws.zero = VecX::Zero(model.dof());
+  const VecX& vi = terms.velocity_products ? v : ws.zero;  // velocity seen by the inertial terms
+  BaseKinematics& bk = ws.bk;
   base_kin(model, q, vi, a, bk);
-  const int nchunks = (n + kChunk - 1) / kChunk;
-  std::vector<BaseMoments> chunk(nchunks);
-  // Each rfe's rotation, evaluated once here and reused by both sdes that touch it. The buffer is
-  // per calling thread; the reference (shared in the parallel regions) names the caller's buffer.
-  thread_local std::vector<RfeRotation> rotation_buffer;
-  std::vector<RfeRotation>& rotations = rotation_buffer;
-  rotations.resize(n);
-#pragma omp parallel for schedule(static) if (n >= g_parallel_min)
+  const int nchunks = ws.chunks(n);
+  // One pass per chunk: rfe k's pose and forces, then sde k (rfes k−1, k) with both rotations —
+  // each rotation is evaluated once, except the one of the rfe before the chunk.
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(n))
   for (int c = 0; c < nchunks; ++c) {
-    RfePose pose;
-    for (int k = c * kChunk; k < std::min(n, (c + 1) * kChunk); ++k) {
-      rfe_pose(d.rfes[k], bk, rfe_coords(q, k), rfe_coords(vi, k), rfe_coords(a, k), pose);
-      rotations[k] = rfe_rotation(pose.d);
-      Vec6 f = Vec6::Zero(), fg;
-      Mat4 Y;
-      Vec4 s;
+    DeformationTransform dt;
+    const int k0 = ws.chunk_begin(c), k1 = ws.chunk_end(c, n);
+    RfeRotation left = k0 > 0 ? rotation_of(rfe_coords(q, k0 - 1)) : clamp_rotation();
+    BaseMoments& mom = ws.moments[c];
+    const Mat3 R0 = bk.B0.topLeftCorner<3, 3>();
+    for (int k = k0; k < k1; ++k) {
+      const Rfe& rfe = d.rfes[k];
+      const Vec6 qk = rfe_coords(q, k);
+      deformation_transform(qk, dt, false);
+      const Vec3 p = bk.B0.topLeftCorner<3, 3>() * (rfe.centre + qk.head<3>()) + bk.B0.topRightCorner<3, 1>();
+      Vec6 f = Vec6::Zero();
       if (terms.inertia) {
-        rfe_inertial_force(d.rfes[k], pose, f, Y);
-        chunk[c].Y += Y;
+        Vec3 fi, ni;
+        rfe_inertia(rfe, bk, dt, rfe_coords(vi, k), rfe_coords(a, k), p, f, fi, ni);
+        mom.f += fi;
+        mom.n += ni;
       }
-      rfe_gravity_force(d.rfes[k], pose, g, fg, s);
-      chunk[c].s += s;
-      F.segment<6>(6 * k) = f + fg;
-    }
-  }
-  if (terms.sde) {
-    const double beta = d.damping_beta;
-    for (int colour = 0; colour < 2; ++colour) {
-#pragma omp parallel for schedule(static) if (n >= g_parallel_min)
-      for (int e = colour; e < n; e += 2) {
-        const Sde& s = d.sdes[e];
-        const Vec6 ql = left_coords(q, e), vl = left_coords(v, e);
+      f.head<3>() += g * rfe.mass * R0.row(2).transpose();  // gravity on the mass centre
+      mom.s += rfe.mass * Vec4(p[0], p[1], p[2], 1.0);
+      F.segment<6>(6 * k) = f;
+      const RfeRotation right = rfe_rotation(dt);
+      if (terms.sde) {
+        const Sde& e = d.sdes[k];
         SdeResult r;
-        sde_forces(s, left_centre(d, s), d.rfes[e].centre, beta, ql, vl, rfe_coords(q, e), rfe_coords(v, e),
-                   e > 0 ? rotations[e - 1] : clamp_rotation(), rotations[e], r);
-        if (e > 0) F.segment<6>(6 * (e - 1)) += r.f.head<6>();
-        F.segment<6>(6 * e) += r.f.tail<6>();
+        sde_forces(e, left_centre(d, e), rfe.centre, beta, left_coords(q, k), left_coords(v, k), qk,
+                   rfe_coords(v, k), left, right, r);
+        if (k == k0) {
+          if (k > 0) ws.boundary[c] = r.f.head<6>();  // rfe k−1 belongs to the previous chunk
+        } else {
+          F.segment<6>(6 * (k - 1)) += r.f.head<6>();
+        }
+        F.segment<6>(6 * k) += r.f.tail<6>();
+        ws.power[c] += r.P_d;
       }
+      left = right;
     }
   }
   BaseMoments flex;
-  for (const auto& c : chunk) flex += c;
-  if (!terms.inertia) flex.Y.setZero();
+  double Pd = 0.0;
+  for (int c = 0; c < nchunks; ++c) {
+    if (c > 0 && terms.sde) F.segment<6>(6 * (ws.chunk_begin(c) - 1)) += ws.boundary[c];
+    flex += ws.moments[c];
+    Pd += ws.power[c];
+  }
+  if (dissipation) *dissipation = Pd;
   const auto S = suffix_moments(model, bk, flex);
   for (int j = 0; j < m; ++j) {
-    double eps = terms.inertia ? trace_prod(bk.Xi[j], S[j].Y) : 0.0;
-    F[6 * n + j] = eps + g * (bk.Xi[j] * S[j].s)[2];
+    const Mat4& X = bk.Xi[j];
+    double eps = 0.0;
+    if (terms.inertia)  // rigid links through Y; the rfes through their wrench and joint j's unit twist
+      eps = trace_prod(X, S[j].Y) + Vec3(X(2, 1), X(0, 2), X(1, 0)).dot(flex.n) + X.topRightCorner<3, 1>().dot(flex.f);
+    F[6 * n + j] = eps + g * (X * S[j].s)[2];
   }
 }
 
-void assemble_matrix(const Model& model, const BorderedPattern& pattern, const std::vector<int>& base_col,
-                     const VecX& q, const VecX& v, const MatrixTerms& t, std::vector<double>& values,
-                     std::vector<double>* sde_stiffness) {
-  const int n = model.n(), m = model.m();
+namespace {
+
+using RowMat6 = Eigen::Matrix<double, 6, 6, Eigen::RowMajor>;
+using Block = Eigen::Map<RowMat6>;
+
+// Adds sde e's 12×12 matrix f·A (coordinates [rfe e−1; rfe e]) to `vals`: D_e, E_e and D_{e−1}
+// (into *left instead when given: that rfe belongs to another chunk).
+void scatter_sde(const BorderedPattern& p, int e, const Mat12& A, std::vector<double>& vals, Mat6* left) {
+  Block(vals.data() + p.diag(e)) += A.bottomRightCorner<6, 6>();
+  if (e == 0) return;
+  Block(vals.data() + p.coupling(e)) += A.topRightCorner<6, 6>();
+  if (left) *left = A.topLeftCorner<6, 6>();
+  else Block(vals.data() + p.diag(e - 1)) += A.topLeftCorner<6, 6>();
+}
+
+}  // namespace
+
+void assemble_matrices(const Model& model, const BorderedPattern& pattern, const std::vector<int>& base_col,
+                       const VecX& q, const VecX& v, const MatrixTerms& t, std::vector<double>& values,
+                       const std::vector<SdeTarget>& extra, MatX* base_rows, Workspace* wsp) {
+  Workspace local;
+  Workspace& ws = wsp ? *wsp : local;
+  const int n = model.n(), m = model.m(), nb = pattern.n_base(), ne = static_cast<int>(extra.size());
   const Discretisation& d = model.link;
   values.assign(pattern.nnz(), 0.0);
-  if (sde_stiffness) sde_stiffness->assign(pattern.nnz(), 0.0);
-  BaseKinematics bk;
-  const VecX zero = VecX::Zero(model.dof());
+  for (const auto& x : extra) x.values->assign(pattern.nnz(), 0.0);
+  if (ws.zero.size() != model.dof()) ws.zero = VecX::Zero(model.dof());
+  const VecX& zero = ws.zero;
+  BaseKinematics& bk = ws.bk;
   base_kin(model, q, v, zero, bk);
   const double g = t.gravity ? model.gravity : 0.0;
-  const int nchunks = (n + kChunk - 1) / kChunk;
-  std::vector<BaseMoments> chunk(nchunks);
-#pragma omp parallel for schedule(static) if (n >= g_parallel_min)
+  const bool sdes = t.stiffness != 0.0 || t.damping != 0.0 || ne > 0;
+  bool damping = d.damping_beta != 0.0 && t.damping != 0.0;
+  for (const auto& x : extra) damping |= d.damping_beta != 0.0 && x.fc != 0.0;
+  const bool second = sdes || t.inertial;  // the geometric stiffness and the centrifugal one need ∂²R
+  const int nchunks = ws.chunks(n);
+  ws.boundary_block.assign(static_cast<size_t>(nchunks) * (1 + ne), Mat6::Zero());
+  if (base_rows) base_rows->setZero(m, pattern.size());
+  std::vector<int> col(m);  // joint → border column (−1 if held)
+  for (int j = 0; j < m; ++j) col[j] = base_col[j] >= 0 ? base_col[j] - 6 * n : -1;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(n))
   for (int c = 0; c < nchunks; ++c) {
     RfePose pose;
     Mat6 Mkk;
-    MatX border;
+    MatX border, gb;
     Mat4 G;
-    for (int k = c * kChunk; k < std::min(n, (c + 1) * kChunk); ++k) {
+    Mat12 Ke, Ce, A;
+    DeformationTransform left;  // the rfe before, for the sde between them
+    const int k0 = ws.chunk_begin(c);
+    if (sdes) deformation_transform(k0 > 0 ? rfe_coords(q, k0 - 1) : Vec6::Zero().eval(), left, true);
+    for (int k = k0; k < ws.chunk_end(c, n); ++k) {
       const Rfe& rfe = d.rfes[k];
-      rfe_pose(rfe, bk, rfe_coords(q, k), rfe_coords(v, k), rfe_coords(zero, k), pose);
+      rfe_pose(rfe, bk, rfe_coords(q, k), rfe_coords(v, k), rfe_coords(zero, k), pose, t.inertial, second);
       rfe_mass_blocks(rfe, pose, bk, Mkk, border, G);
-      chunk[c].G += G;
-      chunk[c].s += pose.W * rfe.H.col(3);
+      ws.moments[c].G += G;
+      ws.moments[c].s += pose.W * rfe.H.col(3);
       Mat6 blk = t.mass * Mkk;
       border *= t.mass;
+      if (base_rows) base_rows->middleCols<6>(6 * k) = border;
       if (t.inertial) blk += t.stiffness * rfe_inertial_stiffness(rfe, pose, bk);
       if (g != 0.0) {
-        MatX gb = MatX::Zero(m, 6);
+        gb.setZero(m, 6);
         rfe_gravity_border(rfe, pose, bk, g, gb);
         border += t.stiffness * gb;
       }
-      for (int l = 0; l < 6; ++l)
-        for (int j = 0; j <= l; ++j) values[pattern.slot(6 * k + j, 6 * k + l)] = blk(j, l);
+      Block(values.data() + pattern.diag(k)) = blk;
       for (int j = 0; j < m; ++j)
-        if (base_col[j] >= 0)
-          for (int l = 0; l < 6; ++l) values[pattern.slot(6 * k + l, base_col[j])] = border(j, l);
+        if (col[j] >= 0)
+          for (int l = 0; l < 6; ++l) values[pattern.border(k) + static_cast<long>(l) * nb + col[j]] = border(j, l);
+      if (!sdes) continue;
+      const Sde& e = d.sdes[k];
+      sde_matrices(e, left_centre(d, e), rfe.centre, d.damping_beta, left_coords(q, k), rfe_coords(q, k), left, pose.d,
+                   Ke, damping ? &Ce : nullptr);
+      const bool first = k == k0 && k > 0;  // its left rfe belongs to the previous chunk
+      const size_t bslot = static_cast<size_t>(c) * (1 + ne);
+      A = t.stiffness * Ke;
+      if (damping) A += t.damping * Ce;
+      scatter_sde(pattern, k, A, values, first ? &ws.boundary_block[bslot] : nullptr);
+      for (int i = 0; i < ne; ++i) {
+        A = extra[i].fk * Ke;
+        if (damping) A += extra[i].fc * Ce;
+        scatter_sde(pattern, k, A, *extra[i].values, first ? &ws.boundary_block[bslot + 1 + i] : nullptr);
+      }
+      left = pose.d;
     }
   }
-  for (int colour = 0; colour < 2; ++colour) {
-#pragma omp parallel for schedule(static) if (n >= g_parallel_min)
-    for (int e = colour; e < n; e += 2) {
-      const Sde& s = d.sdes[e];
-      Mat12 S = Mat12::Zero(), K = Mat12::Zero();
-      const Vec6 ql = left_coords(q, e);
-      sde_matrix(s, left_centre(d, s), d.rfes[e].centre, d.damping_beta, ql, rfe_coords(q, e), t.stiffness,
-                 t.damping, S, sde_stiffness ? &K : nullptr);
-      const int p0 = 6 * e, l0 = 6 * (e - 1);
-      auto scatter = [&](const Mat12& A, std::vector<double>& vals) {
-        for (int b = 0; b < 6; ++b)
-          for (int a = 0; a <= b; ++a) vals[pattern.slot(p0 + a, p0 + b)] += A(6 + a, 6 + b);
-        if (e > 0) {
-          for (int b = 0; b < 6; ++b)
-            for (int a = 0; a <= b; ++a) vals[pattern.slot(l0 + a, l0 + b)] += A(a, b);
-          for (int b = 0; b < 6; ++b)
-            for (int a = 0; a < 6; ++a) vals[pattern.slot(l0 + a, p0 + b)] += A(a, 6 + b);
-        }
-      };
-      scatter(S, values);
-      if (sde_stiffness) scatter(K, *sde_stiffness);
+  if (sdes)
+    for (int c = 1; c < nchunks; ++c) {
+      const int k = ws.chunk_begin(c) - 1;
+      const size_t bslot = static_cast<size_t>(c) * (1 + ne);
+      Block(values.data() + pattern.diag(k)) += ws.boundary_block[bslot];
+      for (int i = 0; i < ne; ++i) Block(extra[i].values->data() + pattern.diag(k)) += ws.boundary_block[bslot + 1 + i];
     }
-  }
   BaseMoments flex;
-  for (const auto& c : chunk) flex += c;
+  for (const auto& c : ws.moments) flex += c;
   const auto S = suffix_moments(model, bk, flex);
   for (int j = 0; j < m; ++j)
-    for (int l = j; l < m; ++l) {
-      if (base_col[j] < 0 || base_col[l] < 0) continue;
+    for (int l = 0; l < m; ++l) {
+      if (col[l] < 0) continue;  // columns are unknowns only
       const int hi = std::max(j, l);
-      double val = t.mass * trace_prod(bk.Xi[j] * S[hi].G, bk.Xi[l].transpose());
+      const double mass = t.mass * trace_prod(bk.Xi[j] * S[hi].G, bk.Xi[l].transpose());
+      if (base_rows) (*base_rows)(j, base_col[l]) = mass;
+      if (col[j] < 0 || l < j) continue;
+      double val = mass;
       if (g != 0.0) val += t.stiffness * g * (bk.Xi[j] * bk.Xi[l] * S[hi].s)[2];
-      const int r = std::min(base_col[j], base_col[l]), c = std::max(base_col[j], base_col[l]);
-      values[pattern.slot(r, c)] += val;
+      values[pattern.base() + static_cast<long>(std::min(col[j], col[l])) * nb + std::max(col[j], col[l])] += val;
     }
 }
 
-MatX to_dense(const BorderedPattern& pattern, const std::vector<double>& values) {
-  MatX A = MatX::Zero(pattern.size(), pattern.size());
-  for (int c = 0; c < pattern.size(); ++c)
-    for (long p = pattern.colptr()[c]; p < pattern.colptr()[c + 1]; ++p) {
-      const long r = pattern.rowind()[p];
-      A(r, c) = A(c, r) = values[p];
-    }
-  return A;
+void assemble_matrix(const Model& model, const BorderedPattern& pattern, const std::vector<int>& base_col,
+                     const VecX& q, const VecX& v, const MatrixTerms& t, std::vector<double>& values, Workspace* ws) {
+  assemble_matrices(model, pattern, base_col, q, v, t, values, {}, nullptr, ws);
 }
 
-Energies energies(const Model& model, const VecX& q, const VecX& v) {
+Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* wsp) {
+  Workspace local;
+  Workspace& ws = wsp ? *wsp : local;
   const int n = model.n(), m = model.m();
   const Discretisation& d = model.link;
   Energies E;
-  BaseKinematics bk;
-  const VecX zero = VecX::Zero(model.dof());
-  base_kin(model, q, v, zero, bk);
+  if (ws.zero.size() != model.dof()) ws.zero = VecX::Zero(model.dof());
+  BaseKinematics& bk = ws.bk;
+  base_kin(model, q, v, ws.zero, bk);
   for (int i = 0; i < m; ++i) {
     const Mat4& H = model.joints[i].H;
     E.kinetic += 0.5 * trace_prod(bk.Wd[i] * H, bk.Wd[i].transpose());
     E.gravity += model.gravity * (bk.W[i] * H.col(3))[2];
   }
-  double T = 0.0, Vg = 0.0, Ve = 0.0, Pd = 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : T, Vg, Ve, Pd) if (n >= g_parallel_min)
-  for (int k = 0; k < n; ++k) {
+  const int nchunks = ws.chunks(n);
+  std::vector<Eigen::Vector4d> part(nchunks, Eigen::Vector4d::Zero());  // T, V_g, V_e, P_d per chunk
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(n))
+  for (int c = 0; c < nchunks; ++c) {
     RfePose pose;
-    rfe_pose(d.rfes[k], bk, rfe_coords(q, k), rfe_coords(v, k), rfe_coords(zero, k), pose);
-    T += rfe_kinetic_energy(d.rfes[k], pose, bk, rfe_coords(v, k));
-    Vg += model.gravity * (pose.W * d.rfes[k].H.col(3))[2];
-    const Sde& s = d.sdes[k];
-    SdeResult r;
-    const Vec6 ql = left_coords(q, k), vl = left_coords(v, k);
-    sde_forces(s, left_centre(d, s), d.rfes[k].centre, d.damping_beta, ql, vl, rfe_coords(q, k), rfe_coords(v, k), r);
-    Ve += r.V;
-    Pd += r.P_d;
+    for (int k = ws.chunk_begin(c); k < ws.chunk_end(c, n); ++k) {
+      rfe_pose(d.rfes[k], bk, rfe_coords(q, k), rfe_coords(v, k), rfe_coords(ws.zero, k), pose, false);
+      const Sde& s = d.sdes[k];
+      SdeResult r;
+      sde_forces(s, left_centre(d, s), d.rfes[k].centre, d.damping_beta, left_coords(q, k), left_coords(v, k),
+                 rfe_coords(q, k), rfe_coords(v, k), r);
+      part[c] += Eigen::Vector4d(rfe_kinetic_energy(d.rfes[k], pose, bk, rfe_coords(v, k)),
+                                 model.gravity * (pose.W * d.rfes[k].H.col(3))[2], r.V, r.P_d);
+    }
   }
-  E.kinetic += T;
-  E.gravity += Vg;
-  E.elastic = Ve;
-  E.dissipation_rate = Pd;
+  Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+  for (const auto& p : part) sum += p;  // chunk order: the same bits for any thread count
+  E.kinetic += sum[0];
+  E.gravity += sum[1];
+  E.elastic = sum[2];
+  E.dissipation_rate = sum[3];
   return E;
 }
 

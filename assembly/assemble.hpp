@@ -1,16 +1,14 @@
 #pragma once
-// Global assembly over rfes and sdes (OpenMP). Per-rfe kernels write their own rows and slots;
-// sdes are coloured by parity (sde e touches rfes e−1 and e) so no two threads write one slot;
-// base-row moments are reduced over fixed chunks of rfes in a fixed order, so results do not
-// depend on the thread count.
+// Global assembly over rfes and sdes (OpenMP), one parallel loop over fixed chunks of rfes
+// (assembly/workspace.hpp). A chunk evaluates its rfes and the sdes ending on them (sde e joins
+// rfes e−1 and e); the first sde's share of the previous chunk's last rfe is kept aside and added
+// after the loop, so no two threads write one slot, and partial sums are combined in chunk order:
+// results do not depend on the thread count.
 #include "assembly/pattern.hpp"
+#include "assembly/workspace.hpp"
 #include "core/kinematics.hpp"
 
 namespace rfem {
-
-/// Smallest number of rfes for which assembly runs in parallel (default 256; tests set 1 to
-/// exercise the parallel paths on small models).
-void set_parallel_min_rfes(int n);
 
 /// Which generalised forces to include (inputs τ are never included: the caller adds them).
 struct ForceTerms {
@@ -22,8 +20,10 @@ struct ForceTerms {
 };
 
 /// F = ε(q, v, a) + ∂V_g/∂q + ∂V_e/∂q + sde damping for all 6n + m coordinates (flexible first).
+/// If `dissipation` is given, the power dissipated in the sdes [W] goes there (same pass).
+/// `ws` (may be null: a temporary one) holds the thread policy and scratch.
 void generalised_forces(const Model& model, const VecX& q, const VecX& v, const VecX& a,
-                        const ForceTerms& terms, VecX& F);
+                        const ForceTerms& terms, VecX& F, double* dissipation = nullptr, Workspace* ws = nullptr);
 
 /// Coefficients of the matrix S = mass·M + damping·C + stiffness·K assembled into the pattern.
 /// K holds the sde stiffness (with its geometric term), and on request the gravity stiffness and
@@ -35,20 +35,28 @@ struct MatrixTerms {
 };
 
 /// Assembles S into `values` (pattern.nnz()); base_col[j] is joint j's column or −1 if held.
-/// If `sde_stiffness` is given, the sde stiffness alone (K with stiffness = 1, no gravity or
-/// inertial terms) goes there in the same pass (the Newton solve needs both S and K).
 void assemble_matrix(const Model& model, const BorderedPattern& pattern, const std::vector<int>& base_col,
                      const VecX& q, const VecX& v, const MatrixTerms& terms, std::vector<double>& values,
-                     std::vector<double>* sde_stiffness = nullptr);
+                     Workspace* ws = nullptr);
 
-/// The symmetric matrix of a pattern's values, dense (tests and small systems).
-MatX to_dense(const BorderedPattern& pattern, const std::vector<double>& values);
+/// Where assemble_matrices also puts the sdes alone: values = fk·K + fc·C (K the sde stiffness
+/// with its geometric term, C the sde damping).
+struct SdeTarget {
+  std::vector<double>* values;
+  double fk = 0.0, fc = 0.0;
+};
+/// S into `values` in one pass over the rfes and sdes, and the sde parts into each extra target
+/// (all reset first). If `base_rows` is given, it receives the rows of every joint (held ones too)
+/// of mass·M over the pattern's columns (m × pattern.size()).
+void assemble_matrices(const Model& model, const BorderedPattern& pattern, const std::vector<int>& base_col,
+                       const VecX& q, const VecX& v, const MatrixTerms& terms, std::vector<double>& values,
+                       const std::vector<SdeTarget>& extra, MatX* base_rows = nullptr, Workspace* ws = nullptr);
 
 struct Energies {
   double kinetic = 0.0, elastic = 0.0, gravity = 0.0;
   double dissipation_rate = 0.0;  ///< power dissipated in the sdes [W]
 };
-Energies energies(const Model& model, const VecX& q, const VecX& v);
+Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* ws = nullptr);
 
 /// Views of one rfe's coordinates in a full coordinate vector.
 inline Vec6 rfe_coords(const VecX& x, int k) { return x.segment<6>(6 * k); }

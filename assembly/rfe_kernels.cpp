@@ -8,12 +8,13 @@ inline Mat34 lift(const Mat4& X, const Mat34& A) { return X.topLeftCorner<3, 3>(
 }  // namespace
 
 void rfe_pose(const Rfe& rfe, const BaseKinematics& bk, const Vec6& q, const Vec6& v, const Vec6& a,
-              RfePose& out) {
-  deformation_transform(q, out.d);
+              RfePose& out, bool accelerations, bool second) {
+  deformation_transform(q, out.d, accelerations || second);
   Mat4 P = out.d.D;
   P.topRightCorner<3, 1>() += rfe.centre;
   out.W = bk.B0 * P;
   out.R0 = bk.B0.topLeftCorner<3, 3>();
+  if (!accelerations) return;
   const Mat34 Pd = d_dot(out.d, v), Pdd = d_ddot(out.d, v, a);
   out.Wdd = (bk.B0dd * P).topRows<3>() + 2.0 * lift(bk.B0d, Pd) + lift(bk.B0, Pdd);
 }
@@ -29,6 +30,32 @@ void rfe_inertial_force(const Rfe& rfe, const RfePose& p, Vec6& eps, Mat4& Y) {
   Y = p.W * rfe.H * Wdd4.transpose();
 }
 
+void rfe_inertia(const Rfe& rfe, const BaseKinematics& bk, const DeformationTransform& d, const Vec6& v,
+                 const Vec6& a, const Vec3& p, Vec6& eps, Vec3& f, Vec3& n) {
+  const Mat3 R0 = bk.B0.topLeftCorner<3, 3>();
+  const Mat3& Om = bk.Omega.topLeftCorner<3, 3>();
+  // Mass centre: a_c = Ω̈-part of {r} at p + Coriolis + relative acceleration.
+  const Vec3 xd = R0 * v.head<3>(), xdd = R0 * a.head<3>();
+  const Vec3 ac = bk.Omega_dd.topLeftCorner<3, 3>() * p + bk.Omega_dd.topRightCorner<3, 1>() + 2.0 * (Om * xd) + xdd;
+  // Rotation R = R_A R_B R_C with axes g (in {r}): ω_rel = Σ g φ̇, ω̇_rel = Σ g φ̈ + (g_A φ̇_A) × (g_B φ̇_B)
+  // + (g_A φ̇_A + g_B φ̇_B) × (g_C φ̇_C) with (A, B, C) = (φ2, φ3, φ1) (core/rotation.hpp).
+  const Vec3 wA = d.axis[1] * v[4], wB = d.axis[2] * v[5], wC = d.axis[0] * v[3];
+  const Vec3 wrel = wA + wB + wC;
+  const Vec3 wdrel = d.axis[0] * a[3] + d.axis[1] * a[4] + d.axis[2] * a[5] + wA.cross(wB) + (wA + wB).cross(wC);
+  const Vec3 wr = R0 * wrel;
+  const Vec3 w = bk.w + wr;
+  const Vec3 alpha = bk.wd + bk.w.cross(wr) + R0 * wdrel;
+  const Mat3 J = rfe.H.topLeftCorner<3, 3>();
+  const Mat3 Rw = R0 * d.D.topLeftCorner<3, 3>();
+  const Mat3 I = Rw * (J.trace() * Mat3::Identity() - J) * Rw.transpose();
+  const Vec3 tau = I * alpha + w.cross(I * w);
+  f = rfe.mass * ac;
+  n = p.cross(f) + tau;
+  eps.head<3>() = R0.transpose() * f;
+  const Vec3 taur = R0.transpose() * tau;
+  for (int k = 0; k < 3; ++k) eps[3 + k] = d.axis[k].dot(taur);
+}
+
 void rfe_gravity_force(const Rfe& rfe, const RfePose& p, double g, Vec6& f, Vec4& s) {
   f.setZero();
   f.head<3>() = g * rfe.mass * p.R0.row(2).transpose();
@@ -37,24 +64,30 @@ void rfe_gravity_force(const Rfe& rfe, const RfePose& p, double g, Vec6& f, Vec4
 
 void rfe_mass_blocks(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, Mat6& Mkk,
                      MatX& border, Mat4& G) {
-  // H = [J 0; 0 m]: translations carry m I, rotations tr(∂R_a J ∂R_bᵀ), no coupling between them.
+  const Mat3 J = rfe.H.topLeftCorner<3, 3>();
+  const Mat3 R = p.d.D.topLeftCorner<3, 3>();
+  const Mat3 Ic = R * (J.trace() * Mat3::Identity() - J) * R.transpose();  // central inertia in {r}
+  Eigen::Matrix<double, 3, 3> IcG;  // I_c g_a
+  for (int a = 0; a < 3; ++a) IcG.col(a) = Ic * p.d.axis[a];
   Mkk.setZero();
   Mkk.topLeftCorner<3, 3>().diagonal().setConstant(rfe.mass);
-  const Mat3 J = rfe.H.topLeftCorner<3, 3>();
-  for (int a = 0; a < 3; ++a) {
-    const Mat3 dRJ = p.d.dR[a] * J;
-    for (int b = a; b < 3; ++b) Mkk(3 + a, 3 + b) = Mkk(3 + b, 3 + a) = (dRJ.array() * p.d.dR[b].array()).sum();
-  }
-  const Mat4 WH = p.W * rfe.H;
+  for (int a = 0; a < 3; ++a)
+    for (int b = a; b < 3; ++b) Mkk(3 + a, 3 + b) = Mkk(3 + b, 3 + a) = p.d.axis[a].dot(IcG.col(b));
   const int m = static_cast<int>(bk.Xi.size());
   border.resize(m, 6);
-  std::array<Mat34, 6> dW;
-  for (int l = 0; l < 6; ++l) dW[l] = p.R0 * p.d.dD[l];
+  const Vec4 ph = p.W.col(3);
   for (int j = 0; j < m; ++j) {
-    const Mat34 XWH = (bk.Xi[j] * WH).topRows<3>();
-    for (int l = 0; l < 6; ++l) border(j, l) = (XWH.array() * dW[l].array()).sum();
+    const Mat4& X = bk.Xi[j];
+    const Vec3 vj = X.topRows<3>() * ph;                               // velocity of the mass centre
+    const Vec3 wj(X(2, 1), X(0, 2), X(1, 0));                           // angular velocity (world)
+    border.block<1, 3>(j, 0) = rfe.mass * (p.R0.transpose() * vj).transpose();
+    border.block<1, 3>(j, 3) = (p.R0.transpose() * wj).transpose() * IcG;
   }
-  G = WH * p.W.transpose();
+  const Mat3 RJ = p.R0 * R;
+  G.topLeftCorner<3, 3>() = RJ * J * RJ.transpose() + rfe.mass * ph.head<3>() * ph.head<3>().transpose();
+  G.topRightCorner<3, 1>() = rfe.mass * ph.head<3>();
+  G.bottomLeftCorner<1, 3>() = rfe.mass * ph.head<3>().transpose();
+  G(3, 3) = rfe.mass;
 }
 
 void rfe_gravity_border(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, double g,

@@ -65,11 +65,14 @@ void sde_forces(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const
   out.P_d = beta * (dx_dot.dot(e.c.cwiseProduct(dx_dot)) + dphi_dot.dot(e.k.cwiseProduct(dphi_dot)));
 }
 
-void sde_matrix(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const Vec6& ql,
-                const Vec6& qp, double ck, double cd, Mat12& S, Mat12* K) {
+namespace {
+
+// The Gauss–Newton part Jᵀ c J + rotational springs ("base", C = β base) and the geometric part
+// Σ_i λ_i ∂²Δx_i/∂φ∂φ, λ = c Δx (the spring force turning with the rfe) of the stiffness.
+void sde_parts(const Sde& e, const Vec3& cl, const Vec3& cr, const Vec6& ql, const Vec6& qp, Mat12& base, Mat12& geo) {
   SdeGeometry g;
   geometry(e, cl, cr, ql, qp, g, true);
-  Mat12 base = g.J.transpose() * e.c.asDiagonal() * g.J;  // Jᵀ c J
+  base.noalias() = g.J.transpose() * e.c.asDiagonal() * g.J;
   for (int a = 0; a < 3; ++a) {
     base(3 + a, 3 + a) += e.k[a];
     base(9 + a, 9 + a) += e.k[a];
@@ -80,21 +83,76 @@ void sde_matrix(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const
     base.topRows<6>().setZero();
     base.leftCols<6>().setZero();
   }
-  S.noalias() += (ck + cd * beta) * base;
-  if (K) K->noalias() += base;
-  // Geometric term Σ_i λ_i ∂²Δx_i/∂φ∂φ, λ = c Δx (the spring force turning with the rfe).
+  geo.setZero();
   const Vec3 lam = e.c.cwiseProduct(g.dx);
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) {
-      const double gp = lam.dot(g.dp.ddR[a][b] * e.eta_right);
-      S(9 + a, 9 + b) += ck * gp;
-      if (K) (*K)(9 + a, 9 + b) += gp;
-      if (e.left >= 0) {
-        const double gl = lam.dot(g.dl.ddR[a][b] * e.eta_left);
-        S(3 + a, 3 + b) -= ck * gl;
-        if (K) (*K)(3 + a, 3 + b) -= gl;
+      geo(9 + a, 9 + b) = lam.dot(g.dp.ddR[a][b] * e.eta_right);
+      if (e.left >= 0) geo(3 + a, 3 + b) = -lam.dot(g.dl.ddR[a][b] * e.eta_left);
+    }
+}
+
+}  // namespace
+
+void sde_matrices(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const Vec6& ql, const Vec6& qp,
+                  Mat12& K, Mat12* C) {
+  Mat12 base, geo;
+  sde_parts(e, cl, cr, ql, qp, base, geo);
+  K = base + geo;
+  if (C) *C = beta * base;
+}
+
+void sde_matrices(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const Vec6& ql, const Vec6& qp,
+                  const DeformationTransform& dl, const DeformationTransform& dp, Mat12& K, Mat12* C) {
+  const bool has_left = e.left >= 0;
+  const Mat3 Rl = dl.D.topLeftCorner<3, 3>(), Rp = dp.D.topLeftCorner<3, 3>();
+  Mat3 Al, Ap;
+  for (int a = 0; a < 3; ++a) {
+    Al.col(a) = dl.dR[a] * e.eta_left;
+    Ap.col(a) = dp.dR[a] * e.eta_right;
+  }
+  const Vec3 dx = cr + Rp * e.eta_right + qp.head<3>() - cl - Rl * e.eta_left - (has_left ? ql.head<3>() : Vec3::Zero().eval());
+  const auto c = e.c.asDiagonal();
+  const Mat3 cAl = c * Al, cAp = c * Ap, cm = e.c.asDiagonal();
+  const Mat3 kd = e.k.asDiagonal();
+  Mat12 B = Mat12::Zero();  // Jᵀ c J + rotational springs, upper and lower blocks
+  B.block<3, 3>(6, 6) = cm;
+  B.block<3, 3>(6, 9) = cAp;
+  B.block<3, 3>(9, 9) = Ap.transpose() * cAp + kd;
+  if (has_left) {
+    B.block<3, 3>(0, 0) = cm;
+    B.block<3, 3>(0, 3) = cAl;
+    B.block<3, 3>(0, 6) = -cm;
+    B.block<3, 3>(0, 9) = -cAp;
+    B.block<3, 3>(3, 3) = Al.transpose() * cAl + kd;
+    B.block<3, 3>(3, 6) = -cAl.transpose();
+    B.block<3, 3>(3, 9) = -Al.transpose() * cAp - kd;
+  }
+  for (int bi = 0; bi < 4; ++bi)
+    for (int bj = 0; bj < bi; ++bj) B.block<3, 3>(3 * bi, 3 * bj) = B.block<3, 3>(3 * bj, 3 * bi).transpose();
+  if (C) *C = beta * B;
+  // Geometric term Σ_i λ_i ∂²Δx_i/∂φ∂φ, λ = c Δx.
+  const Vec3 lam = e.c.cwiseProduct(dx);
+  for (int a = 0; a < 3; ++a)
+    for (int b = a; b < 3; ++b) {
+      const double gp = lam.dot(dp.ddR[a][b] * e.eta_right);
+      B(9 + a, 9 + b) += gp;
+      if (b != a) B(9 + b, 9 + a) += gp;
+      if (has_left) {
+        const double gl = lam.dot(dl.ddR[a][b] * e.eta_left);
+        B(3 + a, 3 + b) -= gl;
+        if (b != a) B(3 + b, 3 + a) -= gl;
       }
     }
+  K = B;
+}
+
+void sde_matrix(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const Vec6& ql,
+                const Vec6& qp, double ck, double cd, Mat12& S, Mat12* K) {
+  Mat12 base, geo;
+  sde_parts(e, cl, cr, ql, qp, base, geo);
+  S.noalias() += (ck + cd * beta) * base + ck * geo;
+  if (K) K->noalias() += base + geo;
 }
 
 }  // namespace rfem

@@ -27,4 +27,14 @@ void sde_forces(const Sde& e, const Vec3& centre_left, const Vec3& centre_right,
 void sde_matrix(const Sde& e, const Vec3& centre_left, const Vec3& centre_right, double beta,
                 const Vec6& ql, const Vec6& qp, double ck, double cd, Mat12& S, Mat12* K = nullptr);
 
+/// The stiffness K = ∂²V/∂q² (with the geometric term) and, if C is given, the damping
+/// C = β Jᵀ c J + rotational part, each assigned (not added).
+void sde_matrices(const Sde& e, const Vec3& centre_left, const Vec3& centre_right, double beta, const Vec6& ql,
+                  const Vec6& qp, Mat12& K, Mat12* C);
+/// The same from both rfes' deformation transforms (with second derivatives), evaluated once per
+/// rfe by the caller, in 3×3 blocks: with A = [∂R/∂φ_a η] and J = [−I, −A_l, I, A_p],
+/// Jᵀ c J = [c, c A_l, −c, −c A_p; ·, A_lᵀ c A_l, −A_lᵀ c, −A_lᵀ c A_p; ·, ·, c, c A_p; ·, ·, ·, A_pᵀ c A_p].
+void sde_matrices(const Sde& e, const Vec3& centre_left, const Vec3& centre_right, double beta, const Vec6& ql,
+                  const Vec6& qp, const DeformationTransform& dl, const DeformationTransform& dp, Mat12& K, Mat12* C);
+
 }  // namespace rfem

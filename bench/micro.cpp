@@ -1,6 +1,7 @@
 // Microbenchmarks (Google Benchmark) of the per-step kernels on the paper's manipulator with its
-// flexible link cut into n rfes: one residual evaluation (generalised forces), one Newton-matrix
-// assembly, one CHOLMOD refactorisation, one solve. Arguments: {n, threads}.
+// flexible link cut into n rfes: one residual evaluation (generalised forces), one assembly of the
+// Newton matrix, assembly + factorisation (chain solver or CHOLMOD), one solve.
+// Arguments: {n, threads[, solver: 0 chain, 1 CHOLMOD]}.
 // Pin threads for stable timings: OMP_PROC_BIND=close OMP_PLACES=cores (see bench/README.md).
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -47,60 +48,52 @@ void BM_Residual(benchmark::State& state) {
   threads(state);
   Setup s(static_cast<int>(state.range(0)));
   VecX F;
+  Workspace ws;
+  ws.parallel.threads = static_cast<int>(state.range(1));
   for (auto _ : state) {
-    generalised_forces(s.model, s.q, s.v, s.a, ForceTerms{}, F);
+    generalised_forces(s.model, s.q, s.v, s.a, ForceTerms{}, F, nullptr, &ws);
     benchmark::DoNotOptimize(F.data());
   }
   per_rfe(state);
 }
 
-void BM_NewtonAssembly(benchmark::State& state) {
+// Assembly of S = M + hC + h²K and its factorisation (the Newton setup of every ESDIRK step);
+// third argument: 0 chain solver, 1 CHOLMOD.
+void BM_NewtonSetup(benchmark::State& state) {
+  threads(state);
+  Setup s(static_cast<int>(state.range(0)));
+  NewtonSystem ns(s.model, s.base_col, s.model.m(), state.range(2) ? LinearSolverKind::Cholmod : LinearSolverKind::Chain);
+  for (auto _ : state) benchmark::DoNotOptimize(ns.setup(s.q, s.v, 0.005));
+  per_rfe(state);
+}
+
+void BM_NewtonAssembly(benchmark::State& state) {  // S alone
   threads(state);
   Setup s(static_cast<int>(state.range(0)));
   const BorderedPattern p(s.model.n(), s.model.m());
   MatrixTerms t;
-  t.mass = 1e4;
-  t.damping = 1e2;
-  t.stiffness = 1.0;
+  t.mass = 1.0;
+  t.damping = 0.005;
+  t.stiffness = 2.5e-5;
   std::vector<double> vals;
+  Workspace ws;
+  ws.parallel.threads = static_cast<int>(state.range(1));
   for (auto _ : state) {
-    assemble_matrix(s.model, p, s.base_col, s.q, s.v, t, vals);
+    assemble_matrix(s.model, p, s.base_col, s.q, s.v, t, vals, &ws);
     benchmark::DoNotOptimize(vals.data());
   }
   per_rfe(state);
 }
 
-void BM_NewtonSetup(benchmark::State& state) {  // assembly of S and K + CHOLMOD refactorisation
+void BM_Solve(benchmark::State& state) {
   threads(state);
   Setup s(static_cast<int>(state.range(0)));
-  NewtonSystem ns(s.model, s.base_col, s.model.m());
-  for (auto _ : state) benchmark::DoNotOptimize(ns.setup(s.q, s.v, 100.0));
-  per_rfe(state);
-}
-
-void BM_Factorize(benchmark::State& state) {
-  threads(state);
-  Setup s(static_cast<int>(state.range(0)));
-  const BorderedPattern p(s.model.n(), s.model.m());
-  MatrixTerms t;
-  t.mass = 1e4;
-  t.stiffness = 1.0;
-  std::vector<double> vals;
-  assemble_matrix(s.model, p, s.base_col, s.q, s.v, t, vals);
-  CholmodSolver solver(p);
-  for (auto _ : state) benchmark::DoNotOptimize(solver.factorize(vals));
-  per_rfe(state);
-}
-
-void BM_NewtonSolve(benchmark::State& state) {
-  threads(state);
-  Setup s(static_cast<int>(state.range(0)));
-  NewtonSystem ns(s.model, s.base_col, s.model.m());
-  ns.setup(s.q, s.v, 100.0);
-  const int u = ns.size();
-  VecX b = VecX::Ones(2 * u), x(2 * u);
+  NewtonSystem ns(s.model, s.base_col, s.model.m(), state.range(2) ? LinearSolverKind::Cholmod : LinearSolverKind::Chain);
+  ns.setup(s.q, s.v, 0.005);
+  VecX b = VecX::Ones(ns.size()), x;
   for (auto _ : state) {
-    ns.solve(b.data(), x.data());
+    x = b;
+    ns.solve(x);
     benchmark::DoNotOptimize(x.data());
   }
   per_rfe(state);
@@ -112,11 +105,17 @@ void args(benchmark::internal::Benchmark* b) {
   b->Unit(benchmark::kMicrosecond)->UseRealTime();
 }
 
+void solver_args(benchmark::internal::Benchmark* b) {
+  for (int n : {10, 100, 1000, 10000})
+    for (int t : {1, 2})
+      for (int k : {0, 1}) b->Args({n, t, k});
+  b->Unit(benchmark::kMicrosecond)->UseRealTime();
+}
+
 }  // namespace
 
 BENCHMARK(BM_Residual)->Apply(args);
 BENCHMARK(BM_NewtonAssembly)->Apply(args);
-BENCHMARK(BM_NewtonSetup)->Apply(args);
-BENCHMARK(BM_Factorize)->Apply(args);
-BENCHMARK(BM_NewtonSolve)->Apply(args);
+BENCHMARK(BM_NewtonSetup)->Apply(solver_args);
+BENCHMARK(BM_Solve)->Apply(solver_args);
 BENCHMARK_MAIN();

@@ -1,12 +1,15 @@
 #!/usr/bin/python3
-"""Whole-run benchmark of rfem: the paper's deployment (kinematic and force input) and Kane's
-spin-up beam at n = 6, 60, 600, 6000 with 1 and 2 threads.
+"""Whole-run benchmark of rfem at its default settings: the paper's deployment (kinematic and force
+input) and Kane's spin-up beam over a series of n, with `--threads 1`, `--threads 2` and without
+--threads ("auto": each run times one thread against two and keeps the faster).
 
-Prints one table row per run: wall time, IDA steps, residual evaluations, factorisations, wall time
-per rfe per residual evaluation, peak memory (max RSS of the process) and, per case and thread
-count, the fitted exponent p of wall ∝ n^p between the two largest n.
+Prints one table row per run: median wall time over --repeat runs, steps, residual evaluations,
+factorisations, wall time per rfe per step and per residual evaluation, peak memory (max RSS of the
+process, its growth per rfe between the two largest n) and, per case and thread mode, the fitted
+exponent p of wall ∝ n^p between the two largest n.
 
-  /usr/bin/python3 bench/run_bench.py [--rfem build/apps/rfem] [--ns 6,60,600,6000] [--threads 1,2]
+  /usr/bin/python3 bench/run_bench.py [--ns 600,2000,10000] [--threads 1,2,auto] [--repeat 3]
+      [--cases deployment,spinup] [--set key=value …]
 Threads are pinned with OMP_PROC_BIND=close OMP_PLACES=cores.
 """
 import argparse, json, math, os, subprocess, sys, tempfile
@@ -18,11 +21,13 @@ CASES = {
 }
 
 
-def run_measured(rfem, case, n, threads, tmp):
+def run_measured(rfem, case, n, threads, tmp, sets):
     """Runs rfem and returns (json, max RSS in MB) using wait4 on the child."""
-    env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_PROC_BIND="close", OMP_PLACES="cores")
+    env = dict(os.environ, OMP_PROC_BIND="close", OMP_PLACES="cores")
     out = os.path.join(tmp, f"b{n}_{threads}.h5")
-    cmd = [rfem, "run", case, "--n", str(n), "--json", "-o", out]
+    cmd = [rfem] + ([] if threads == "auto" else ["--threads", threads]) + ["run", case, "--n", str(n), "--json", "-o", out]
+    for x in sets:
+        cmd += ["--set", x]
     with tempfile.TemporaryFile() as so, tempfile.TemporaryFile() as se:
         p = subprocess.Popen(cmd, stdout=so, stderr=se, env=env)
         _, status, usage = os.wait4(p.pid, 0)
@@ -38,35 +43,42 @@ def run_measured(rfem, case, n, threads, tmp):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--rfem", default=os.path.join(HERE, "..", "build", "apps", "rfem"))
-    ap.add_argument("--ns", default="6,60,600,6000")
-    ap.add_argument("--threads", default="1,2")
+    ap.add_argument("--ns", default="600,2000,10000")
+    ap.add_argument("--threads", default="1,2,auto")
     ap.add_argument("--cases", default="deployment,spinup")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--set", action="append", default=[], help="case override for every run (key.path=value)")
     a = ap.parse_args()
     ns = [int(x) for x in a.ns.split(",")]
-    ths = [int(x) for x in a.threads.split(",")]
-    print(f"machine: {os.cpu_count()} cores, {os.uname().machine}, {os.uname().release}")
-    hdr = f"{'case':<11}{'run':<10}{'n':>6}{'thr':>4}{'wall [s]':>10}{'steps':>8}{'resid':>8}{'fact':>6}" \
-          f"{'us/rfe/res':>11}{'RSS [MB]':>9}"
+    ths = a.threads.split(",")
+    print(f"machine: {os.cpu_count()} cores, {os.uname().machine}, {os.uname().release}; median of {a.repeat}")
+    hdr = f"{'case':<11}{'run':<10}{'n':>6}{'thr':>5}{'wall [s]':>10}{'steps':>8}{'resid':>8}{'fact':>6}" \
+          f"{'us/rfe/step':>12}{'us/rfe/res':>11}{'RSS [MB]':>9}"
     print(hdr)
     fits = []
     with tempfile.TemporaryDirectory() as tmp:
         for case in a.cases.split(","):
             for th in ths:
-                walls = {}
+                walls, rsss = {}, {}
                 for n in ns:
-                    js, rss = run_measured(a.rfem, CASES[case], n, th, tmp)
+                    reps = [run_measured(a.rfem, CASES[case], n, th, tmp, a.set) for _ in range(a.repeat)]
+                    rsss[n] = max(r[1] for r in reps)
                     total = 0.0
-                    for r in js["runs"]:
-                        per = r["wall_time_s"] / max(1, r["residual_evals"]) / n * 1e6
-                        print(f"{case:<11}{r['name']:<10}{n:>6}{th:>4}{r['wall_time_s']:>10.3f}{r['steps']:>8}"
-                              f"{r['residual_evals']:>8}{r['factorizations']:>6}{per:>11.3f}{rss:>9.1f}")
-                        total += r["wall_time_s"]
+                    for i, r in enumerate(reps[0][0]["runs"]):
+                        wall = sorted(rep[0]["runs"][i]["wall_time_s"] for rep in reps)[len(reps) // 2]
+                        step = wall / max(1, r["steps"]) / n * 1e6
+                        per = wall / max(1, r["residual_evals"]) / n * 1e6
+                        print(f"{case:<11}{r['name']:<10}{n:>6}{th:>5}{wall:>10.3f}{r['steps']:>8}"
+                              f"{r['residual_evals']:>8}{r['factorizations']:>6}{step:>12.3f}{per:>11.3f}{rsss[n]:>9.1f}")
+                        total += wall
                     walls[n] = total
                     sys.stdout.flush()
                 big = sorted(walls)[-2:]
                 if len(big) == 2 and walls[big[0]] > 0:
                     p = math.log(walls[big[1]] / walls[big[0]]) / math.log(big[1] / big[0])
-                    fits.append(f"{case}, {th} thread(s): wall ∝ n^{p:.2f} between n = {big[0]} and {big[1]}")
+                    kb = (rsss[big[1]] - rsss[big[0]]) * 1024 / (big[1] - big[0])
+                    fits.append(f"{case}, threads {th}: wall ∝ n^{p:.2f} between n = {big[0]} and {big[1]}; "
+                                f"memory {kb:.2f} KB per rfe")
     for f in fits:
         print(f)
 

@@ -3,6 +3,7 @@
 #include <toml++/toml.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
@@ -28,6 +29,36 @@ class Reader {
     else os << " (--set or missing)";
     os << ": " << key << ": " << what;
     throw CaseError(os.str());
+  }
+
+  /// A legal but suspicious value: a one-line warning naming file, line and key.
+  void warn(const toml::node* node, const std::string& key, const std::string& what) const {
+    std::ostringstream os;
+    os << file_;
+    if (node && node->source().begin.line > 0) os << ":" << node->source().begin.line;
+    os << ": " << key << ": " << what;
+    warnings_.push_back(os.str());
+  }
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+  /// An angle [rad]: a number (radians), or a string "90 deg" / "1.5 rad". A plain number beyond
+  /// ±2π is taken as radians but warned about (TOML has no π; degrees are a common slip).
+  double angle(const toml::table& t, const std::string& path, const std::string& key, double dflt) const {
+    const toml::node* n = t.get(key);
+    const std::string k = join(path, key);
+    if (!n) return dflt;
+    if (auto s = n->as_string()) {
+      std::istringstream is(s->get());
+      double v = 0.0;
+      std::string unit;
+      if (!(is >> v) || !(is >> unit) || (unit != "deg" && unit != "rad") || !std::isfinite(v))
+        fail(n, k, "an angle is a number (radians) or a string \"<number> deg\" or \"<number> rad\" (got \"" + s->get() + "\")");
+      return unit == "deg" ? v * M_PI / 180.0 : v;
+    }
+    const double v = number(t, path, key, dflt);
+    if (std::abs(v) > 2 * M_PI + 1e-9)
+      warn(n, k, "|" + fmt(v) + "| rad is more than a turn: if degrees were meant, write \"" + fmt(v) + " deg\"");
+    return v;
   }
 
   void check_keys(const toml::table& t, const std::string& path, const std::set<std::string>& allowed) const {
@@ -115,6 +146,7 @@ class Reader {
   }
 
   static std::string join(const std::string& a, const std::string& b) { return a.empty() ? b : a + "." + b; }
+  mutable std::vector<std::string> warnings_;
   static std::string fmt(double v) {
     std::ostringstream os;
     os << v;
@@ -199,6 +231,10 @@ Material read_material(const Reader& r, const toml::table& t, const std::string&
   m.E = r.positive(t, path, "E");
   m.G = r.positive(t, path, "G");
   m.rho = r.positive(t, path, "rho");
+  if (m.G > m.E / 2)
+    r.warn(t.get("G"), path + ".G", "G > E/2 means a negative Poisson's ratio (nu = E/2G - 1 = " + Reader::fmt(m.E / (2 * m.G) - 1) + ")");
+  if (m.E < 1e5) r.warn(t.get("E"), path + ".E", "E = " + Reader::fmt(m.E) + " Pa is very small: units are SI (Pa), not GPa or MPa");
+  if (m.rho < 10) r.warn(t.get("rho"), path + ".rho", "rho = " + Reader::fmt(m.rho) + " kg/m^3 is very small: units are SI (kg/m^3), not g/cm^3");
   return m;
 }
 
@@ -225,6 +261,16 @@ Section read_section(const Reader& r, const toml::table& t, const std::string& p
   s.kappa_y = r.positive(t, path, "kappa_y", 5.0 / 6.0);
   s.kappa_z = r.positive(t, path, "kappa_z", 5.0 / 6.0);
   s.offset = Vec3(0.0, r.number(t, path, "offset_y", 0.0), r.number(t, path, "offset_z", 0.0));
+  for (const char* k : {"Iy", "Iz"}) {
+    const double I = k[1] == 'y' ? s.Iy : s.Iz;
+    // A thin tube of radius ρ and wall t has I/A² = ρ/(4πt): 10 A² is a wall of ρ/125 (Kane's beam,
+    // a real one, has I = 1.25 A²).
+    if (I > 10 * s.A * s.A)
+      r.warn(t.get(k), path + "." + k, "a second moment of 10 A^2 or more (" + Reader::fmt(I) + " m^4 against A^2 = " +
+                                           Reader::fmt(s.A * s.A) + " m^4) needs an extremely thin wall: check the units (m^4, m^2)");
+  }
+  if (s.J > 1.0001 * (s.Iy + s.Iz))
+    r.warn(t.get("J"), path + ".J", "a torsion constant larger than Iy + Iz is impossible for a real section");
   return s;
 }
 
@@ -327,22 +373,41 @@ InputSpec read_input(const Reader& r, const toml::table& t, const std::string& p
 
 Simulation read_simulation(const Reader& r, const toml::table& t) {
   const std::string p = "simulation";
-  r.check_keys(t, p, {"t_end", "output_dt", "rtol", "atol", "atol_velocity", "max_step", "procedure", "store_flexible_every", "max_order",
-                    "max_steps"});
+  r.check_keys(t, p, {"t_end", "output_dt", "rtol", "atol", "atol_velocity", "max_step", "procedure", "store_flexible_every",
+                      "max_order", "max_steps", "integrator", "method", "initial"});
   Simulation s;
-  s.t_end = r.positive(t, p, "t_end");
-  s.output_dt = r.positive(t, p, "output_dt", std::min(0.01, s.t_end));
-  if (s.output_dt > s.t_end) r.fail(t.get("output_dt"), p + ".output_dt", "must not exceed t_end");
-  s.rtol = r.positive(t, p, "rtol", 1e-6);
-  s.atol = r.positive(t, p, "atol", 1e-8);
-  s.atol_velocity = r.positive(t, p, "atol_velocity", 1e-5);
-  s.max_step = r.non_negative(t, p, "max_step", 0.0);
-  s.procedure = r.string(t, p, "procedure", std::string("single"));
+  IntegratorOptions& o = s.options;
+  o.t_end = r.positive(t, p, "t_end");
+  o.output_dt = r.positive(t, p, "output_dt", std::min(o.output_dt, o.t_end));
+  if (o.output_dt > o.t_end) r.fail(t.get("output_dt"), p + ".output_dt", "must not exceed t_end");
+  o.rtol = r.positive(t, p, "rtol", o.rtol);
+  o.atol = r.positive(t, p, "atol", o.atol);
+  o.atol_velocity = r.positive(t, p, "atol_velocity", o.atol_velocity);
+  o.max_step = r.non_negative(t, p, "max_step", o.max_step);
+  s.procedure = r.string(t, p, "procedure", s.procedure);
   if (s.procedure != "single" && s.procedure != "paper")
     r.fail(t.get("procedure"), p + ".procedure", "must be \"single\" or \"paper\" (got \"" + s.procedure + "\")");
-  s.flexible_every = static_cast<int>(r.integer(t, p, "store_flexible_every", 0, 0, 1000000000));
-  s.max_order = static_cast<int>(r.integer(t, p, "max_order", 2, 1, 5));
-  s.max_steps = r.integer(t, p, "max_steps", 20000, 1, 1000000000);
+  s.flexible_every = static_cast<int>(r.integer(t, p, "store_flexible_every", s.flexible_every, 0, 1000000000));
+  const std::string kind = r.string(t, p, "integrator", integrator_name(o.kind));
+  if (!parse_integrator(kind, o.kind))
+    r.fail(t.get("integrator"), p + ".integrator", "must be \"esdirk\" or \"bdf\" (got \"" + kind + "\")");
+  o.max_order = static_cast<int>(r.integer(t, p, "max_order", o.max_order, 1, 5));
+  if (t.get("max_order") && o.kind != IntegratorKind::Bdf)
+    r.fail(t.get("max_order"), p + ".max_order", "applies to integrator = \"bdf\" only");
+  o.esdirk_table = r.string(t, p, "method", o.esdirk_table);
+  if (t.get("method")) {
+    if (o.kind != IntegratorKind::Esdirk) r.fail(t.get("method"), p + ".method", "applies to integrator = \"esdirk\" only");
+    try {
+      check_esdirk_table(o.esdirk_table);
+    } catch (const std::exception& e) {
+      r.fail(t.get("method"), p + ".method", e.what());
+    }
+  }
+  o.max_steps = r.integer(t, p, "max_steps", o.max_steps, 1, 1000000000);
+  const std::string initial = r.string(t, p, "initial", o.initial == InitialState::Static ? "static" : "undeformed");
+  if (initial != "static" && initial != "undeformed")
+    r.fail(t.get("initial"), p + ".initial", "must be \"static\" or \"undeformed\" (got \"" + initial + "\")");
+  o.initial = initial == "static" ? InitialState::Static : InitialState::Undeformed;
   return s;
 }
 
@@ -352,6 +417,7 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
   Case c;
   c.path = path;
   std::ifstream in(path);
+  if (std::filesystem::is_directory(path)) throw CaseError(path + ": is a directory, not a case file (e.g. " + path + "/paper_deployment.toml)");
   if (!in) throw CaseError(path + ": cannot open case file");
   std::stringstream buf;
   buf << in.rdbuf();
@@ -365,6 +431,12 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
     throw CaseError(os.str());
   }
   for (const auto& o : overrides) apply_override(root, path, o);
+  c.overrides = overrides;
+  {
+    std::ostringstream os;
+    os << root;
+    c.effective_text = os.str();
+  }
   const Reader r(path);
   r.check_keys(root, "", {"case", "materials", "sections", "link", "joints", "gravity", "loads", "simulation"});
   const auto slash = path.find_last_of('/');
@@ -430,11 +502,12 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
       if (type == "revolute") j.type = JointType::Revolute;
       else if (type == "prismatic") j.type = JointType::Prismatic;
       else r.fail(jt.get("type"), p + ".type", "must be \"revolute\" or \"prismatic\" (got \"" + type + "\")");
-      j.alpha = r.number(jt, p, "alpha", 0.0);
+      j.alpha = r.angle(jt, p, "alpha", 0.0);
       j.a = r.number(jt, p, "a", 0.0);
-      j.theta = r.number(jt, p, "theta", 0.0);
+      j.theta = r.angle(jt, p, "theta", 0.0);
       j.d = r.number(jt, p, "d", 0.0);
-      c.joint_values[static_cast<long>(i)] = r.number(jt, p, "value", 0.0);
+      c.joint_values[static_cast<long>(i)] =
+          j.type == JointType::Revolute ? r.angle(jt, p, "value", 0.0) : r.number(jt, p, "value", 0.0);
       c.joint_rates[static_cast<long>(i)] = r.number(jt, p, "rate", 0.0);
       if (const toml::node* bn = jt.get("body")) {
         if (!bn->is_table()) r.fail(bn, p + ".body", "must be a table");
@@ -476,6 +549,7 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
     c.loads.force = r.vec3(*ln->as_table(), "loads", "tip_force", Vec3::Zero());
     c.loads.moment = r.vec3(*ln->as_table(), "loads", "tip_moment", Vec3::Zero());
   }
+  c.warnings = r.warnings();
   return c;
 }
 

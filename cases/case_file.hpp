@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/model.hpp"
+#include "solvers/integrator.hpp"
 #include "solvers/statics.hpp"
 
 namespace rfem {
@@ -28,18 +29,20 @@ struct InputSpec {
   bool prescribed() const { return kind == "deployment" || kind == "spinup" || kind == "constant_rate" || kind == "table"; }
 };
 
-/// The `[simulation]` table: time integration settings.
+/// The `[simulation]` table: the integrator's settings (their defaults are IntegratorOptions') and
+/// what to run and store.
 struct Simulation {
-  double t_end = 1.0, output_dt = 0.01, rtol = 1e-6, atol = 1e-8, atol_velocity = 1e-5, max_step = 0.0;
+  IntegratorOptions options;
   std::string procedure = "single";  ///< single | paper (rigid inverse dynamics, kinematic, force input)
   int flexible_every = 0;            ///< store the full flexible state every k outputs (0: never)
-  int max_order = 2;                 ///< highest BDF order (2: A-stable over undamped stiff sde modes)
-  long max_steps = 20000;            ///< IDA steps allowed per output interval
 };
 
 struct Case {
   std::string path;
   std::string text;  ///< the file as read (stored with results)
+  std::string effective_text;          ///< the case after the overrides, as TOML
+  std::vector<std::string> overrides;  ///< the --set key.path=value strings applied
+  std::vector<std::string> warnings;   ///< legal but suspicious values ("file:line: key: …")
   std::string name, description;
   bool has_link = false;
   FlexibleLink link;

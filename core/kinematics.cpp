@@ -28,6 +28,9 @@ void base_kinematics(const Model& model, const VecX& qb, const VecX& vb, const V
   out.B0d = Omega * out.B0;
   out.B0dd = Alpha * out.B0;
   out.Omega_dd = Alpha;
+  out.Omega = Omega;
+  out.w = Vec3(Omega(2, 1), Omega(0, 2), Omega(1, 0));
+  out.wd = 0.5 * Vec3(Alpha(2, 1) - Alpha(1, 2), Alpha(0, 2) - Alpha(2, 0), Alpha(1, 0) - Alpha(0, 1));
 }
 
 }  // namespace rfem

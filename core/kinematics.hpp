@@ -13,6 +13,11 @@ struct BaseKinematics {
   std::vector<Mat4> Wd, Wdd;  ///< Ẇ_i, Ẅ_i
   Mat4 B0, B0d, B0dd;     ///< pose of {r} and its first and second time derivatives
   Mat4 Omega_dd = Mat4::Zero();  ///< Ẅ W⁻¹ for the last link (applies to every rfe)
+  /// Motion of {r} as a rigid body: angular velocity Ω and acceleration Ω̇ (in {0}); Ẇ W⁻¹ = Omega
+  /// has the top-left [Ω×], and Ω̇ is the skew part of Omega_dd's top-left (Omega² adds a
+  /// symmetric [Ω×]²).
+  Mat4 Omega = Mat4::Zero();
+  Vec3 w = Vec3::Zero(), wd = Vec3::Zero();
 };
 
 /// Evaluates base kinematics at joint values q_b, rates v_b and accelerations a_b.

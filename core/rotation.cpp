@@ -42,26 +42,30 @@ void deformation_transform(const Vec6& q, DeformationTransform& out, bool second
   Ry << c2, 0, s2, 0, 1, 0, -s2, 0, c2;
   Rz << c3, -s3, 0, s3, c3, 0, 0, 0, 1;
   const Mat3 dRx = d_rot_x(c1, s1), dRy = d_rot_y(c2, s2), dRz = d_rot_z(c3, s3);
-  const Mat3 RyRz = Ry * Rz, RxRy = Rx * Ry;
-  out.D = homogeneous(Rx * RyRz, q.head<3>());
+  // R = Ry(φ2) Rz(φ3) Rx(φ1): torsion innermost, about the rfe's own axis.
+  const Mat3 RyRz = Ry * Rz, RzRx = Rz * Rx;
+  out.D = homogeneous(RyRz * Rx, q.head<3>());
   for (int j = 0; j < 3; ++j) {
     out.dD[j].setZero();
     out.dD[j](j, 3) = 1.0;
   }
-  out.dR[0] = dRx * RyRz;
-  out.dR[1] = Rx * (dRy * Rz);
-  out.dR[2] = RxRy * dRz;
+  out.dR[0] = RyRz * dRx;
+  out.dR[1] = dRy * RzRx;
+  out.dR[2] = Ry * (dRz * Rx);
   for (int a = 0; a < 3; ++a) {
     out.dD[3 + a].setZero();
     out.dD[3 + a].leftCols<3>() = out.dR[a];
   }
+  out.axis[0] = RyRz.col(0);
+  out.axis[1] = Vec3::UnitY();
+  out.axis[2] = Ry.col(2);
   if (!second) return;
-  out.ddR[0][0] = dd_rot_x(c1, s1) * RyRz;
-  out.ddR[1][1] = Rx * (dd_rot_y(c2, s2) * Rz);
-  out.ddR[2][2] = RxRy * dd_rot_z(c3, s3);
-  out.ddR[0][1] = out.ddR[1][0] = dRx * (dRy * Rz);
-  out.ddR[0][2] = out.ddR[2][0] = (dRx * Ry) * dRz;
-  out.ddR[1][2] = out.ddR[2][1] = Rx * (dRy * dRz);
+  out.ddR[0][0] = RyRz * dd_rot_x(c1, s1);
+  out.ddR[1][1] = dd_rot_y(c2, s2) * RzRx;
+  out.ddR[2][2] = Ry * (dd_rot_z(c3, s3) * Rx);
+  out.ddR[0][1] = out.ddR[1][0] = dRy * (Rz * dRx);
+  out.ddR[0][2] = out.ddR[2][0] = Ry * (dRz * dRx);
+  out.ddR[1][2] = out.ddR[2][1] = dRy * (dRz * Rx);
 }
 
 RfeRotation rfe_rotation(const DeformationTransform& d) { return {d.D.topLeftCorner<3, 3>(), d.dR}; }

@@ -1,6 +1,10 @@
 #pragma once
-// The rfe deformation transform D(q) = [R(φ) x; 0 1], R = RotX(φ1) RotY(φ2) RotZ(φ3)  [2.4],
-// with its first and second partial derivatives in the six rfe coordinates q = [x1 x2 x3 φ1 φ2 φ3].
+// The rfe deformation transform D(q) = [R(φ) x; 0 1] [2.4] with its first and second partial
+// derivatives in the six rfe coordinates q = [x1 x2 x3 φ1 φ2 φ3] (φ1 about the link axis x).
+// R = RotY(φ2) RotZ(φ3) RotX(φ1): the paper's R = Rot1(φ1) Rot2(φ2) Rot3(φ3) with its link axis
+// (3) mapped to our x, so torsion is the innermost rotation, about the rfe's own axis. (With the
+// torsion outermost, turning a bent rfe about the axis of {r} would swing its attachment points
+// against the stiff shear springs and tilt its large bending inertia into the torsion row.)
 #include "core/types.hpp"
 
 namespace rfem {
@@ -18,6 +22,7 @@ struct DeformationTransform {
   std::array<Mat34, 6> dD;          ///< ∂D/∂q_j
   std::array<std::array<Mat3, 3>, 3> ddR;  ///< ∂²R/∂φ_a∂φ_b (translations enter D linearly)
   std::array<Mat3, 3> dR;           ///< ∂R/∂φ_a
+  std::array<Vec3, 3> axis;         ///< g_a with ∂R/∂φ_a = [g_a×] R (the rotation axes in {r})
 };
 
 /// R(φ) and ∂R/∂φ of one rfe: all the sde forces need (kept per rfe during a residual evaluation).

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs everything rfem needs on Debian 12 (run as root): Debian packages, then SUNDIALS 6.4.1
-# (IDA only, Release, no MPI) built from Debian's source package into .deps/sundials.
+# (IDA and ARKODE, Release, no MPI) built from Debian's source package into .deps/sundials.
 # Why not libsundials-dev: it is built at -O0 and pulls in MPI/PETSc (see shared/TOOLCHAIN.md).
 # Idempotent: packages already present and an existing SUNDIALS build are reused.
 set -euo pipefail
@@ -22,12 +22,15 @@ if ((${#missing[@]})); then
   apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-if [[ -f "$prefix/lib/cmake/sundials/SUNDIALSConfig.cmake" || -f "$prefix/lib64/cmake/sundials/SUNDIALSConfig.cmake" ]]; then
+# ARKODE supplies the Butcher tables of the ESDIRK methods (solvers/esdirk.cpp); a prefix from
+# an older checkout without it is rebuilt.
+if ls "$prefix"/lib*/libsundials_arkode.a >/dev/null 2>&1; then
   echo "install-deps: SUNDIALS already built in $prefix"
   exit 0
 fi
 
 # deb-src for sundials through a private apt configuration (the system's lists stay untouched).
+rm -rf "$prefix"
 work="$here/.deps/src"; rm -rf "$work"; mkdir -p "$work/lists/partial" "$work/archives/partial"
 srclist="$work/sources.list"
 : >"$srclist"
@@ -49,7 +52,7 @@ apt-get "${aptopts[@]}" update -qq
 tarball=$(ls "$work"/sundials_*.orig.tar.* | head -n1)
 mkdir -p "$work/sundials" && tar -xf "$tarball" -C "$work/sundials" --strip-components=1
 cmake -S "$work/sundials" -B "$work/build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_INSTALL_PREFIX="$prefix" -DBUILD_ARKODE=OFF -DBUILD_CVODE=OFF -DBUILD_CVODES=OFF \
+  -DCMAKE_INSTALL_PREFIX="$prefix" -DBUILD_ARKODE=ON -DBUILD_CVODE=OFF -DBUILD_CVODES=OFF \
   -DBUILD_IDA=ON -DBUILD_IDAS=OFF -DBUILD_KINSOL=OFF -DBUILD_FORTRAN_MODULE_INTERFACE=OFF \
   -DENABLE_MPI=OFF -DENABLE_OPENMP=OFF -DENABLE_PTHREAD=OFF -DEXAMPLES_ENABLE_C=OFF \
   -DEXAMPLES_INSTALL=OFF -DBUILD_SHARED_LIBS=OFF -DBUILD_STATIC_LIBS=ON \

@@ -36,6 +36,36 @@ double cantilever_omega(const Segment& s, ModeKind kind, int k) {
   return 0.0;
 }
 
+double cantilever_omega_timoshenko(const Segment& s, ModeKind kind, int k) {
+  const bool y = kind == ModeKind::BendingY;  // deflection along y bends about z
+  const double L = s.length, E = s.material.E, G = s.material.G, rho = s.material.rho, A = s.section.A;
+  const double I = y ? s.section.Iz : s.section.Iy, kappa = y ? s.section.kappa_y : s.section.kappa_z;
+  const double r2 = I / (A * L * L), s2 = E * I / (kappa * G * A * L * L);
+  auto f = [&](double b) {
+    const double root = std::sqrt((r2 - s2) * (r2 - s2) + 4.0 / (b * b));
+    const double al = std::sqrt(std::max(0.0, -(r2 + s2) + root) / 2.0), be = std::sqrt(((r2 + s2) + root) / 2.0);
+    const double d = (r2 - s2) * (r2 - s2);
+    return 2.0 + (b * b * d + 2.0) * std::cosh(b * al) * std::cos(b * be) -
+           b * (r2 + s2) / std::sqrt(1.0 - b * b * r2 * s2) * std::sinh(b * al) * std::sin(b * be);
+  };
+  // The Timoshenko root lies below the Euler–Bernoulli one b = (βL)²: scan down from it for the
+  // sign change, then bisect.
+  const double b_eb = std::pow(cantilever_beta_l(k), 2);
+  double hi = b_eb * 1.0001, lo = hi;
+  const double fhi = f(hi);
+  for (int i = 0; i < 4000; ++i) {
+    lo = hi * (1.0 - 1e-4 * (i + 1));
+    if ((f(lo) > 0) != (fhi > 0)) break;
+  }
+  double a = lo, c = b_eb * 1.0001;
+  for (int i = 0; i < 200 && c - a > 1e-15 * c; ++i) {
+    const double m = 0.5 * (a + c);
+    ((f(m) > 0) == (f(a) > 0) ? a : c) = m;
+  }
+  const double b = 0.5 * (a + c);
+  return b * std::sqrt(E * I / (rho * A * std::pow(L, 4)));
+}
+
 double cantilever_tip_deflection(const Segment& s, double P, bool along_z) {
   const double L = s.length;
   const double I = along_z ? s.section.Iy : s.section.Iz;

@@ -10,6 +10,12 @@ namespace rfem::beam {
 double cantilever_beta_l(int k);
 /// k-th natural circular frequency [rad/s] of a uniform cantilever of the given kind.
 double cantilever_omega(const Segment& s, ModeKind kind, int k);
+/// k-th bending frequency [rad/s] of a uniform Timoshenko cantilever (shear deformation and rotary
+/// inertia: what the RFEM discretisation converges to), from the clamped–free frequency equation
+///   2 + [b²(r²−s²)² + 2] cosh(bα) cos(bβ) − b(r²+s²)/√(1 − b²r²s²) sinh(bα) sin(bβ) = 0,
+/// b² = ρAL⁴ω²/(EI), r² = I/(AL²), s² = EI/(κGAL²), α, β = √(∓(r²+s²) + √((r²−s²)² + 4/b²))/√2
+/// (Han, Benaroya & Wei, J. Sound Vib. 225(5), 1999). `kind`: BendingY or BendingZ.
+double cantilever_omega_timoshenko(const Segment& s, ModeKind kind, int k);
 /// Static tip deflection under a transverse tip force P along y (bending about z) or z:
 /// P L³/(3 E I) + P L/(κ G A).
 double cantilever_tip_deflection(const Segment& s, double P, bool along_z);

@@ -17,13 +17,14 @@ CholmodSolver::CholmodSolver(const BorderedPattern& pattern) : pattern_(pattern)
   common_->postorder = 0;
   common_->print = 0;
   common_->quick_return_if_not_posdef = 1;
-  // A views the pattern's arrays and, at each factorisation, the caller's values: no copies.
+  // A views the pattern's compressed columns and, at each factorisation, the values gathered into them.
   static_assert(sizeof(SuiteSparse_long) == sizeof(long));
   A_ = new cholmod_sparse{};
   A_->nrow = A_->ncol = static_cast<size_t>(pattern.size());
-  A_->nzmax = static_cast<size_t>(pattern.nnz());
-  A_->p = const_cast<long*>(pattern.colptr().data());
-  A_->i = const_cast<long*>(pattern.rowind().data());
+  const auto& z = pattern.csc();
+  A_->nzmax = z.rowind.size();
+  A_->p = const_cast<long*>(z.colptr.data());
+  A_->i = const_cast<long*>(z.rowind.data());
   A_->stype = 1;  // upper triangle stored
   A_->itype = CHOLMOD_LONG;
   A_->xtype = CHOLMOD_PATTERN;  // the analysis needs no values
@@ -42,8 +43,11 @@ CholmodSolver::~CholmodSolver() {
   delete common_;
 }
 
-bool CholmodSolver::factorize(const std::vector<double>& values) {
-  A_->x = const_cast<double*>(values.data());
+bool CholmodSolver::factorize(std::vector<double>& values) {
+  const auto& z = pattern_.csc();
+  x_.resize(z.slot.size());
+  for (size_t p = 0; p < x_.size(); ++p) x_[p] = values[z.slot[p]];
+  A_->x = x_.data();
   cholmod_l_factorize(A_, L_, common_);
   A_->x = nullptr;
   if (common_->status == CHOLMOD_NOT_POSDEF) {

@@ -4,8 +4,7 @@
 // (supernodes are tiny on this pattern; see shared/TOOLCHAIN.md).
 #include <vector>
 
-#include "assembly/pattern.hpp"
-#include "core/types.hpp"
+#include "solvers/linear_solver.hpp"
 
 struct cholmod_common_struct;
 struct cholmod_sparse_struct;
@@ -13,7 +12,7 @@ struct cholmod_factor_struct;
 
 namespace rfem {
 
-class CholmodSolver {
+class CholmodSolver : public LinearSolver {
  public:
   explicit CholmodSolver(const BorderedPattern& pattern);
   ~CholmodSolver();
@@ -22,9 +21,9 @@ class CholmodSolver {
 
   /// Refactorises with new values (pattern order). Returns false if the matrix is not positive
   /// definite (the caller may cut the step); the failing column is in failed_column().
-  bool factorize(const std::vector<double>& values);
+  bool factorize(std::vector<double>& values) override;
   /// Solves S x = b in place with the last successful factorisation.
-  void solve(VecX& b) const;
+  void solve(VecX& b) const override;
   long failed_column() const { return failed_column_; }
 
  private:
@@ -33,6 +32,7 @@ class CholmodSolver {
   cholmod_sparse_struct* A_ = nullptr;
   cholmod_factor_struct* L_ = nullptr;
   long failed_column_ = -1;
+  std::vector<double> x_;  // the values in compressed columns
 };
 
 }  // namespace rfem

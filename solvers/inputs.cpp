@@ -18,6 +18,7 @@ class Deployment : public MotionLaw {
     const double w = 2 * M_PI / T_;
     return {psi0_ - k_ * (t - std::sin(w * t) / w), -k_ * (1 - std::cos(w * t)), -k_ * w * std::sin(w * t)};
   }
+  std::vector<double> breakpoints() const override { return {T_}; }  // the jerk jumps at the end
 
  private:
   double psi0_, k_, T_;
@@ -32,6 +33,7 @@ class Spinup : public MotionLaw {
     return {th0_ + (W_ / T_) * (t * t / 2 + (std::cos(w * t) - 1) / (w * w)), (W_ / T_) * (t - std::sin(w * t) / w),
             (W_ / T_) * (1 - std::cos(w * t))};
   }
+  std::vector<double> breakpoints() const override { return {T_}; }
 
  private:
   double th0_, W_, T_;
@@ -83,6 +85,7 @@ class Spline : public MotionLaw {
     s.qdd = A * m_[i - 1] + B * m_[i];
     return s;
   }
+  std::vector<double> breakpoints() const override { return t_; }  // the third derivative jumps at nodes
 
  private:
   std::vector<double> t_, q_, m_;
@@ -111,18 +114,30 @@ class LinearTorque : public TorqueLaw {
     const double w = (t - t_[i - 1]) / (t_[i] - t_[i - 1]);
     return (1 - w) * v_[i - 1] + w * v_[i];
   }
+  std::vector<double> breakpoints() const override { return t_; }  // kinks at the nodes
 
  private:
   std::vector<double> t_, v_;
 };
 
+class SplineTorque : public TorqueLaw {
+ public:
+  SplineTorque(std::vector<double> t, std::vector<double> tau) : s_(std::move(t), std::move(tau)) {}
+  double at(double t) const override { return s_.at(t).q; }
+
+ private:
+  Spline s_;
+};
+
 class FunctionTorque : public TorqueLaw {
  public:
-  explicit FunctionTorque(std::function<double(double)> f) : f_(std::move(f)) {}
+  FunctionTorque(std::function<double(double)> f, std::vector<double> b) : f_(std::move(f)), b_(std::move(b)) {}
   double at(double t) const override { return f_(t); }
+  std::vector<double> breakpoints() const override { return b_; }
 
  private:
   std::function<double(double)> f_;
+  std::vector<double> b_;
 };
 
 }  // namespace
@@ -141,8 +156,11 @@ std::shared_ptr<TorqueLaw> constant_torque(double tau) { return std::make_shared
 std::shared_ptr<TorqueLaw> tabulated_torque(std::vector<double> t, std::vector<double> tau) {
   return std::make_shared<LinearTorque>(std::move(t), std::move(tau));
 }
-std::shared_ptr<TorqueLaw> torque_function(std::function<double(double)> f) {
-  return std::make_shared<FunctionTorque>(std::move(f));
+std::shared_ptr<TorqueLaw> spline_torque(std::vector<double> t, std::vector<double> tau) {
+  return std::make_shared<SplineTorque>(std::move(t), std::move(tau));
+}
+std::shared_ptr<TorqueLaw> torque_function(std::function<double(double)> f, std::vector<double> breakpoints) {
+  return std::make_shared<FunctionTorque>(std::move(f), std::move(breakpoints));
 }
 
 void read_csv_series(const std::string& path, std::vector<double>& t, std::vector<double>& v) {

@@ -19,12 +19,15 @@ class MotionLaw {
  public:
   virtual ~MotionLaw() = default;
   virtual MotionSample at(double t) const = 0;
+  /// Times where the law is less smooth (a jump in a derivative): integrators end steps there.
+  virtual std::vector<double> breakpoints() const { return {}; }
 };
 
 class TorqueLaw {
  public:
   virtual ~TorqueLaw() = default;
   virtual double at(double t) const = 0;
+  virtual std::vector<double> breakpoints() const { return {}; }
 };
 
 /// Kane's deployment law (the dimensionally consistent form, FORMULATION.md §3):
@@ -41,8 +44,11 @@ std::shared_ptr<MotionLaw> tabulated_motion(std::vector<double> t, std::vector<d
 std::shared_ptr<TorqueLaw> constant_torque(double tau);
 /// Piecewise-linear interpolation of (t_i, τ_i); held constant beyond the ends.
 std::shared_ptr<TorqueLaw> tabulated_torque(std::vector<double> t, std::vector<double> tau);
-/// Any callable τ(t).
-std::shared_ptr<TorqueLaw> torque_function(std::function<double(double)> f);
+/// Natural cubic spline through (t_i, τ_i): error O(Δt⁴) for smooth torques (the samples of an
+/// earlier run); t outside the table is an error.
+std::shared_ptr<TorqueLaw> spline_torque(std::vector<double> t, std::vector<double> tau);
+/// Any callable τ(t), smooth except at the given times.
+std::shared_ptr<TorqueLaw> torque_function(std::function<double(double)> f, std::vector<double> breakpoints = {});
 
 /// Reads a two-column CSV (time, value), '#' comments and one optional header line allowed.
 /// Throws std::runtime_error naming the file and line.
@@ -53,6 +59,7 @@ struct JointInput {
   std::shared_ptr<TorqueLaw> torque;  ///< set: force input (initial value and rate from q0, v0)
   double q0 = 0.0, v0 = 0.0;
   bool prescribed() const { return static_cast<bool>(motion); }
+  std::vector<double> breakpoints() const { return motion ? motion->breakpoints() : torque->breakpoints(); }
 };
 
 }  // namespace rfem

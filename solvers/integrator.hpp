@@ -1,46 +1,59 @@
 #pragma once
-// Time integration with SUNDIALS IDA of  q' = v,  M(q) v' + h(q, v) + f_el + f_g + f_d = τ
-// (FORMULATION.md §5) over the unknown coordinates: the 6n rfe coordinates and the joints under
-// force input. Joints under kinematic input follow their laws; their torques come out of the base
-// rows (inverse dynamics). Two extra states integrate the dissipated energy and the input work.
-// Our own IDA linear solver factorises S = c_j² M + c_j C + K on the bordered pattern with CHOLMOD
-// and solves the 2N Newton system exactly for that (symmetric, approximate) Jacobian.
+// Time integration of  q' = v,  M(q) v' + h(q, v) + f_el + f_g + f_d = τ  (FORMULATION.md §5) over
+// the unknown coordinates: the 6n rfe coordinates and the joints under force input. Joints under
+// kinematic input follow their laws; their torques come out of the base rows (inverse dynamics).
+// The dissipated energy and the input work are integrated alongside.
+//
+// Two integrators, both on the bordered Newton matrix S = M + hγ C + (hγ)² K factorised on the
+// unknowns' pattern (solvers/newton_system.hpp):
+//  - `esdirk` (default): an L-stable, stiffly accurate singly diagonally implicit Runge–Kutta method
+//    with an explicit first stage, order 3–5 (Kennedy & Carpenter's ESDIRK tables as shipped by
+//    SUNDIALS ARKODE), written for the implicit second-order form (solvers/esdirk.cpp);
+//  - `bdf`: SUNDIALS IDA (variable-step BDF, order ≤ max_order) with our CHOLMOD linear solver.
 #include <atomic>
 #include <functional>
 #include <string>
 
-#include "assembly/assemble.hpp"
-#include "solvers/inputs.hpp"
+#include "solvers/equations.hpp"
 
 namespace rfem {
 
+enum class IntegratorKind { Esdirk, Bdf };
+
+/// Where a run starts: the rfes in static equilibrium (gravity and, for joints with initial rates,
+/// the centrifugal load) with the joints at their initial values — or undeformed. At rest relative
+/// to {r} either way.
+enum class InitialState { Static, Undeformed };
+
 struct IntegratorOptions {
+  IntegratorKind kind = IntegratorKind::Esdirk;
+  /// ESDIRK table (an ARKODE DIRK table name without the "ARKODE_" prefix). It must have an
+  /// explicit first stage, one diagonal coefficient, be stiffly accurate and embedded.
+  std::string esdirk_table = "ESDIRK547L2SA2_7_4_5";
+  /// Factorisation of the Newton matrix (solvers/linear_solver.hpp).
+  LinearSolverKind linear_solver = LinearSolverKind::Chain;
   double t_end = 1.0;       ///< [s]
   double output_dt = 0.01;  ///< output interval [s]
-  double rtol = 1e-6;
-  double atol = 1e-8;            ///< absolute tolerance on coordinates [m, rad]
+  /// Relative tolerance. The default keeps the integration error of the paper's deployment below
+  /// 1e-4 of the peaks of u1, u2, θ and the joint torques (README, "Performance"): a refinement
+  /// study in n then measures the discretisation, not the integrator.
+  double rtol = 1e-8;
+  double atol = 1e-10;           ///< absolute tolerance on coordinates [m, rad]
   /// Absolute tolerance on velocities [m/s, rad/s]. Undamped stiff sde modes (the joint turning
-  /// against the first sde, ω ∝ n²) carry velocities far above their tiny displacements; an atol
-  /// on velocities as small as on coordinates would force IDA to resolve them.
+  /// against the first sde, ω ∝ n²) carry velocities far above their tiny displacements.
   double atol_velocity = 1e-5;
-  double atol_energy = 1e-6;     ///< on the dissipated-energy and input-work integrals [J]
-  double max_step = 0.0;    ///< 0: IDA's default (no limit)
-  long max_steps = 20000;   ///< internal steps per output interval before giving up
-  /// Highest BDF order. BDF orders above 2 are not A-stable: the undamped axial and shear sde
-  /// modes (ω ~ 1e3–1e5 rad/s) would force tiny steps. BDF2 steps over them.
+  double atol_energy = 1e-6;     ///< on the dissipated-energy and input-work integrals [J] (BDF)
+  double max_step = 0.0;    ///< 0: no limit
+  /// ESDIRK with constant steps of this size [s] and no error control (0: adaptive). For
+  /// measuring the temporal order; steps still end at the inputs' breakpoints and at t_end.
+  double fixed_step = 0.0;
+  long max_steps = 20000;   ///< steps per output interval before giving up
+  /// Highest BDF order (bdf only). Orders above 2 are not A-stable: the undamped axial and shear
+  /// sde modes (ω ~ 1e3–1e5 rad/s) would force tiny steps. BDF2 steps over them.
   int max_order = 2;
+  InitialState initial = InitialState::Static;
   ForceTerms forces;  ///< all on for physics; tests switch velocity products off
-};
-
-/// One output step: full coordinates, the torque of every joint (applied or required) and energies.
-struct OutputSample {
-  double t = 0.0;
-  VecX q, v, a;   ///< full coordinates (flexible first, base last)
-  VecX tau;       ///< joint torques/forces [N m or N], applied (force input) or required (kinematic)
-  Energies energy;
-  double dissipated = 0.0, input_work = 0.0;  ///< integrals since t = 0 [J]
-  long steps = 0;        ///< IDA steps taken so far (for progress reports)
-  double last_step = 0;  ///< IDA's last step size [s]
+  Parallelism parallel;  ///< threads of the kernels (results do not depend on it)
 };
 
 struct IntegratorStats {
@@ -55,10 +68,38 @@ struct RunOutcome {
   IntegratorStats stats;
 };
 
+/// "esdirk" / "bdf" and back; parse returns false for an unknown name.
+std::string integrator_name(IntegratorKind k);
+bool parse_integrator(const std::string& name, IntegratorKind& k);
+/// Throws std::invalid_argument naming what is wrong if `name` is not a usable ESDIRK table.
+void check_esdirk_table(const std::string& name);
+
+using SampleSink = std::function<void(const OutputSample&)>;
+
 /// Integrates from t = 0 (rfes undeformed and at rest) to t_end, calling `sink` at t = 0 and every
 /// output_dt. `stop` (may be null) is polled: non-zero interrupts the run cleanly.
 /// With no unknowns (rigid manipulator, all joints prescribed) it evaluates inverse dynamics only.
 RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, const IntegratorOptions& opts,
-                     const std::function<void(const OutputSample&)>& sink, const std::atomic<int>* stop = nullptr);
+                     const SampleSink& sink, const std::atomic<int>* stop = nullptr);
+
+/// What a run will cost, known before it starts (issue 11: a run of 200 000 rfes gave no warning).
+struct RunEstimate {
+  double bytes = 0.0;          ///< peak memory of the integration [B] (measured per rfe, see .cpp)
+  double residual_s = 0.0;     ///< one residual evaluation [s], timed on this machine (0 if not timed)
+  double newton_setup_s = 0.0; ///< one assembly + factorisation of the Newton matrix [s] (0 if not timed)
+  /// Seconds per integrator step: an ESDIRK5 step takes ~12 residual evaluations and one Newton
+  /// matrix (README, "Performance"); 0 if not timed.
+  double step_s() const { return 12.0 * residual_s + newton_setup_s; }
+};
+/// Runs with at least this many rfes get a timed estimate and a note before they start.
+inline constexpr int kLargeRunRfes = 10000;
+/// The memory of a run from the model's size; with `time` also one residual evaluation and one
+/// Newton setup timed at the undeformed initial state (allocates what the run will allocate).
+RunEstimate estimate_run(const Model& model, const std::vector<JointInput>& inputs, const IntegratorOptions& opts,
+                         bool time);
+
+/// The integrators behind integrate() (the equations hold the unknowns' layout and Newton system).
+RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& opts, const SampleSink& sink);
+RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, const SampleSink& sink);
 
 }  // namespace rfem

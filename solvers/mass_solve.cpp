@@ -6,7 +6,7 @@ bool solve_mass(const Model& model, const BorderedPattern& pattern, const std::v
                 const VecX& q, const VecX& v, VecX& b, std::vector<double>& values) {
   MatrixTerms mt;
   mt.mass = 1.0;
-  assemble_matrix(model, pattern, base_col, q, v, mt, values);
+  assemble_matrices(model, pattern, base_col, q, v, mt, values, {});
   const int n = pattern.n_rfes(), nb = pattern.n_base(), n6 = 6 * n;
   auto entry = [&](int r, int c) { return values[pattern.slot(std::min(r, c), std::max(r, c))]; };
   MatX S(nb, nb);  // Schur complement on the free joints

@@ -38,7 +38,7 @@ BlockMass block_mass(const Model& model, const VecX& q) {
   base_kinematics(model, q.tail(model.m()), z, z, bk);
   for (int k = 0; k < n; ++k) {
     RfePose pose;
-    rfe_pose(model.link.rfes[k], bk, q.segment<6>(6 * k), Vec6::Zero(), Vec6::Zero(), pose);
+    rfe_pose(model.link.rfes[k], bk, q.segment<6>(6 * k), Vec6::Zero(), Vec6::Zero(), pose, false);
     MatX border;
     Mat4 G;
     rfe_mass_blocks(model.link.rfes[k], pose, bk, bm.M[k], border, G);
@@ -89,6 +89,20 @@ ModeKind classify(const VecX& phi, const BlockMass& bm) {
   return static_cast<ModeKind>(best);
 }
 
+// ‖K φ − λ M φ‖ / (‖K φ‖ + |λ| ‖M φ‖) of each eigenpair.
+VecX eigen_residuals(const BorderedPattern& p, const std::vector<double>& K, const BlockMass& bm, const VecX& lambda,
+                     const MatX& shapes) {
+  VecX r(lambda.size());
+  for (int i = 0; i < lambda.size(); ++i) {
+    const VecX phi = shapes.col(i);
+    VecX Kp, Mp(phi.size());
+    p.multiply(K, phi, Kp);
+    for (size_t k = 0; k < bm.M.size(); ++k) Mp.segment<6>(6 * k) = bm.M[k] * phi.segment<6>(6 * k);
+    r[i] = (Kp - lambda[i] * Mp).norm() / std::max(Kp.norm() + std::abs(lambda[i]) * Mp.norm(), 1e-300);
+  }
+  return r;
+}
+
 }  // namespace
 
 ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, int count, int dense_limit) {
@@ -117,24 +131,36 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
     res.shapes = es.eigenvectors().leftCols(count);
   } else {
     res.dense = false;
-    ShiftInvertOp op(pattern, K, bm);
-    const int ncv = std::min(N, std::max(2 * count + 1, count + 20));
-    Spectra::SymEigsShiftSolver<ShiftInvertOp> eigs(op, count, ncv, 0.0);
-    eigs.init();
-    eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
-    if (eigs.info() != Spectra::CompInfo::Successful) throw std::runtime_error("modal analysis: Lanczos did not converge");
-    const VecX ev = eigs.eigenvalues();
-    const MatX U = eigs.eigenvectors();
-    // Spectra returns the eigenvalues of A (back-transformed), largest 1/(λ−σ) first: reverse.
-    lambda.resize(count);
-    res.shapes.resize(N, count);
-    for (int i = 0; i < count; ++i) {
-      lambda[i] = ev[count - 1 - i];
-      VecX u = U.col(count - 1 - i);
-      for (int k = 0; k < n; ++k)  // φ = L⁻ᵀ u
-        res.shapes.col(i).segment<6>(6 * k) = bm.L[k].transpose().triangularView<Eigen::Upper>().solve(u.segment<6>(6 * k));
+    // Shift-invert Lanczos at σ = 0; if an eigenpair comes back inaccurate (the stiff axial springs
+    // make K ill-conditioned for many rfes), once more with σ just below the lowest eigenvalue,
+    // where the wanted eigenvalues of (K − σM)⁻¹M are large and well separated.
+    auto lanczos = [&](double sigma) {
+      ShiftInvertOp op(pattern, K, bm);
+      const int ncv = std::min(N, std::max(2 * count + 1, count + 20));
+      Spectra::SymEigsShiftSolver<ShiftInvertOp> eigs(op, count, ncv, sigma);
+      eigs.init();
+      eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
+      if (eigs.info() != Spectra::CompInfo::Successful) throw std::runtime_error("modal analysis: Lanczos did not converge");
+      const VecX ev = eigs.eigenvalues();
+      const MatX U = eigs.eigenvectors();
+      // Spectra returns the eigenvalues of A (back-transformed), largest 1/(λ−σ) first: reverse.
+      lambda.resize(count);
+      res.shapes.resize(N, count);
+      for (int i = 0; i < count; ++i) {
+        lambda[i] = ev[count - 1 - i];
+        VecX u = U.col(count - 1 - i);
+        for (int k = 0; k < n; ++k)  // φ = L⁻ᵀ u
+          res.shapes.col(i).segment<6>(6 * k) = bm.L[k].transpose().triangularView<Eigen::Upper>().solve(u.segment<6>(6 * k));
+      }
+    };
+    lanczos(0.0);
+    res.residual = eigen_residuals(pattern, K, bm, lambda, res.shapes);
+    if (res.residual.maxCoeff() > kResidualTolerance && lambda.minCoeff() > 0.0) {
+      res.shift = 0.9 * lambda.minCoeff();
+      lanczos(res.shift);
     }
   }
+  res.residual = eigen_residuals(pattern, K, bm, lambda, res.shapes);
   res.omega = lambda.cwiseMax(0.0).cwiseSqrt();
   for (int i = 0; i < count; ++i) res.kind.push_back(classify(res.shapes.col(i), bm));
   return res;

@@ -19,7 +19,13 @@ struct ModesResult {
   std::vector<ModeKind> kind;  ///< dominant motion (BendingY: deflection along y)
   VecX q0;                ///< the equilibrium linearised about
   bool dense = true;      ///< which eigen-solver ran
+  double shift = 0.0;     ///< Lanczos: the shift of the last solve
+  /// ‖Kφ − λMφ‖ / (‖Kφ‖ + |λ|‖Mφ‖) of each mode: round-off is ~1e-12; above kResidualTolerance the
+  /// eigen-solution cannot be trusted (commands warn).
+  VecX residual;
 };
+
+constexpr double kResidualTolerance = 1e-8;
 
 /// Lowest `count` modes. `vb` are the steady joint rates (empty or zero: no rotation).
 /// `dense_limit`: largest 6n solved densely.

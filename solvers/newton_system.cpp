@@ -1,39 +1,55 @@
 #include "solvers/newton_system.hpp"
 
-#include <Eigen/SparseCore>
-
 namespace rfem {
 
-NewtonSystem::NewtonSystem(const Model& model, std::vector<int> base_col, int nb)
-    : model_(model), base_col_(std::move(base_col)), pattern_(model.n(), nb), solver_(pattern_) {}
+NewtonSystem::NewtonSystem(const Model& model, std::vector<int> base_col, int nb, LinearSolverKind kind,
+                           Workspace* ws, bool keep_stiffness)
+    : model_(model),
+      ws_(ws ? *ws : own_),
+      base_col_(std::move(base_col)),
+      pattern_(model.n(), nb),
+      solver_(make_linear_solver(kind, pattern_)),
+      damped_(model.link.damping_beta != 0.0),
+      keep_stiffness_(keep_stiffness) {}
 
-bool NewtonSystem::setup(const VecX& q, const VecX& v, double c) {
+bool NewtonSystem::setup(const VecX& q, const VecX& v, double h) {
   MatrixTerms terms;
-  terms.mass = c * c;
-  terms.damping = c;
-  terms.stiffness = 1.0;
-  assemble_matrix(model_, pattern_, base_col_, q, v, terms, S_, &K_);
-  c_ = c;
-  return solver_.factorize(S_);
+  terms.mass = 1.0;
+  terms.damping = h;
+  terms.stiffness = h * h;
+  std::vector<SdeTarget> extra;
+  if (keep_stiffness_) extra.push_back({&K_, 1.0, 0.0});
+  if (damped_) extra.push_back({&C_, 0.0, 1.0});
+  assemble_matrices(model_, pattern_, base_col_, q, v, terms, S_, extra, &base_rows_, &ws_);
+  h_ = h;
+  solver_->set_threads(ws_.parallel.team(model_.n()));
+  return solver_->factorize(S_);
 }
 
-void NewtonSystem::stiffness_times(const double* x, double* y) const {
-  // The stored upper triangle as an Eigen sparse view: its symmetric product is vectorised.
-  const int N = pattern_.size();
-  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::ColMajor, long>> K(
-      N, N, pattern_.nnz(), pattern_.colptr().data(), pattern_.rowind().data(), K_.data());
-  Eigen::Map<VecX>(y, N).noalias() = K.selfadjointView<Eigen::Upper>() * Eigen::Map<const VecX>(x, N);
+void NewtonSystem::solve(VecX& b) const {
+  solver_->set_threads(ws_.parallel.team(model_.n()));
+  solver_->solve(b);
 }
 
-void NewtonSystem::solve(const double* b, double* x) const {
+void NewtonSystem::damping_times(const VecX& x, VecX& y) const {
+  if (!damped_) {
+    y.setZero(x.size());
+    return;
+  }
+  pattern_.multiply(C_, x, y);
+}
+
+void NewtonSystem::solve_bdf(const double* b, double* x) const {
   const int u = size();
-  VecX Kb1(u);
-  stiffness_times(b, Kb1.data());
-  VecX rhs = c_ * Eigen::Map<const VecX>(b + u, u) - Kb1;
-  solver_.solve(rhs);
+  const double c = 1.0 / h_;
+  VecX Kb1;
+  pattern_.multiply(K_, Eigen::Map<const VecX>(b, u), Kb1);
+  VecX rhs = c * Eigen::Map<const VecX>(b + u, u) - Kb1;
+  solve(rhs);  // S(h) = h² (c² M + c C + K): x2 = S⁻¹ rhs / c²
+  rhs *= h_ * h_;
   for (int i = 0; i < u; ++i) {
     x[u + i] = rhs[i];
-    x[i] = (b[i] + rhs[i]) / c_;
+    x[i] = (b[i] + rhs[i]) * h_;
   }
 }
 

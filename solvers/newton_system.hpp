@@ -1,35 +1,50 @@
 #pragma once
-// The Newton system of IDA for y = [q_u; v_u]:
-//   [c I, −I; K, C + c M] [x1; x2] = [b1; b2]
-// solved through its Schur complement (c² M + c C + K) x2 = c b2 − K b1, x1 = (b1 + x2)/c, with
-// S = c² M + c C + K factorised by CHOLMOD on the bordered pattern (FORMULATION.md §5). M, C, K are
-// the mass, sde damping and sde stiffness (the symmetric parts of the exact Jacobian), so the solve
-// is exact for that approximate Jacobian.
+// The Newton matrix of the time integrators on the unknowns' bordered pattern,
+//   S(h) = M + h C + h² K,
+// with M the mass matrix, C the sde damping and K the sde stiffness (with its geometric term): the
+// symmetric positive definite part of ∂r/∂a + h ∂r/∂v + h² ∂r/∂q. Assembled in one pass at a
+// state and factorised by the chosen LinearSolver (the chain solver in place: S costs one array).
+//
+// For IDA (c = c_j = 1/h) the 2N system [c I, −I; K, C + c M] [x1; x2] = [b1; b2] is solved
+// through its Schur complement: (c² M + c C + K) x2 = c b2 − K b1, x1 = (b1 + x2)/c; K is then
+// kept as well.
 #include "assembly/assemble.hpp"
-#include "solvers/cholmod_solver.hpp"
+#include "solvers/linear_solver.hpp"
 
 namespace rfem {
 
 class NewtonSystem {
  public:
   /// base_col[j]: joint j's column among the unknowns (numbered after the 6n rfe coordinates), −1
-  /// if prescribed; nb = number of unknown joints.
-  NewtonSystem(const Model& model, std::vector<int> base_col, int nb);
-  /// Assembles and factorises at (q, v) for coefficient c. Returns false if S is not positive definite.
-  bool setup(const VecX& q, const VecX& v, double c);
-  /// Solves for x = [x1; x2] (2·size()) given b (2·size()), with the c of the last setup.
-  void solve(const double* b, double* x) const;
+  /// if prescribed; nb = number of unknown joints. `ws`: the caller's workspace (thread policy and
+  /// scratch of the assembly), or null for one of its own. `keep_stiffness`: keep K (IDA's solve).
+  NewtonSystem(const Model& model, std::vector<int> base_col, int nb, LinearSolverKind kind = LinearSolverKind::Chain,
+               Workspace* ws = nullptr, bool keep_stiffness = false);
+  /// Assembles S(h) at a state (full coordinates) and factorises it. False if not positive definite.
+  bool setup(const VecX& q, const VecX& v, double h);
+  /// Solves S(h) x = b in place (the h of the last setup).
+  void solve(VecX& b) const;
+  /// IDA's system for x = [x1; x2] (2·size()) given b, with c = 1/h of the last setup.
+  void solve_bdf(const double* b, double* x) const;
+  double h() const { return h_; }
   int size() const { return pattern_.size(); }
   const BorderedPattern& pattern() const { return pattern_; }
+  /// Rows of every joint of M over the unknowns (m × size()), at the last setup.
+  const MatX& base_rows() const { return base_rows_; }
+  /// y = C x with the sde damping of the last setup (zero if undamped).
+  void damping_times(const VecX& x, VecX& y) const;
 
  private:
-  void stiffness_times(const double* x, double* y) const;
   const Model& model_;
+  Workspace own_;
+  Workspace& ws_;
   std::vector<int> base_col_;
   BorderedPattern pattern_;
-  CholmodSolver solver_;
-  std::vector<double> S_, K_;
-  double c_ = 0.0;
+  std::unique_ptr<LinearSolver> solver_;
+  std::vector<double> S_, K_, C_;
+  MatX base_rows_;
+  bool damped_, keep_stiffness_;
+  double h_ = 0.0;
 };
 
 }  // namespace rfem

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "assembly/assemble.hpp"
+#include "core/kinematics.hpp"
 #include "core/rotation.hpp"
 #include "solvers/cholmod_solver.hpp"
 
@@ -15,9 +16,9 @@ Vec6 tip_generalised_force(const Model& model, const Vec6& qn, const TipLoads& l
   deformation_transform(qn, d);
   Vec6 Q;
   Q.head<3>() = loads.force;
-  // Angular velocity of R = Rx Ry Rz in {r}: ω = e1 φ̇1 + Rx e2 φ̇2 + Rx Ry e3 φ̇3.
-  const Mat3 Rx = rot_x(qn[3]), Rxy = Rx * rot_y(qn[4]);
-  const Vec3 axes[3] = {Vec3::UnitX(), Rx.col(1), Rxy.col(2)};
+  // Angular velocity of R = Ry Rz Rx in {r}: ω = Ry Rz e1 φ̇1 + e2 φ̇2 + Ry e3 φ̇3.
+  const Mat3 Ry = rot_y(qn[4]), Ryz = Ry * rot_z(qn[5]);
+  const Vec3 axes[3] = {Ryz.col(0), Vec3::UnitY(), Ry.col(2)};
   for (int a = 0; a < 3; ++a)
     Q[3 + a] = loads.force.dot(d.dR[a] * model.link.tip_eta) + loads.moment.dot(axes[a]);
   return Q;
@@ -34,6 +35,21 @@ Vec6 tip_motion(const Model& model, const VecX& q) {
   out.head<3>() = qn.head<3>() + d.D.topLeftCorner<3, 3>() * eta - eta;
   out.tail<3>() = qn.tail<3>();
   return out;
+}
+
+Vec3 tip_position(const Model& model, const VecX& q) {
+  const int m = model.m(), n = model.n();
+  BaseKinematics bk;
+  const VecX z = VecX::Zero(m);
+  base_kinematics(model, q.tail(m), z, z, bk);
+  Vec3 local = Vec3(model.link.length, 0.0, 0.0);  // the rigid manipulator: the link's end, rigid with {r}
+  if (n > 0) {
+    const Vec6 qn = q.segment<6>(6 * (n - 1));
+    DeformationTransform d;
+    deformation_transform(qn, d, false);
+    local = model.link.rfes.back().centre + qn.head<3>() + d.D.topLeftCorner<3, 3>() * model.link.tip_eta;
+  }
+  return bk.B0.topLeftCorner<3, 3>() * local + bk.B0.topRightCorner<3, 1>();
 }
 
 namespace {

@@ -37,5 +37,7 @@ Vec6 tip_generalised_force(const Model& model, const Vec6& qn, const TipLoads& l
 
 /// Tip displacement (3, in {r}) and small rotation (3) of the free end relative to undeformed.
 Vec6 tip_motion(const Model& model, const VecX& q);
+/// Position of the free end (on the elastic axis) in the inertial frame {0} (full coordinates q).
+Vec3 tip_position(const Model& model, const VecX& q);
 
 }  // namespace rfem

@@ -24,7 +24,7 @@ PY
 }
 
 for sig in INT TERM; do
-  "$rfem" run "$src/cases/paper_deployment.toml" --n 400 --quiet -o "$sig.h5" &
+  "$rfem" run "$src/cases/paper_deployment.toml" --n 2000 --quiet -o "$sig.h5" &
   pid=$!
   sleep 3
   kill -"$sig" "$pid"
@@ -40,8 +40,8 @@ done
   --set simulation.output_dt=0.001 2>err.txt
 code=$?
 [ "$code" = 1 ] && echo "ok exit 1 on integrator failure" || { echo "FAIL exit $code on integrator failure"; fail=1; }
-grep -q "rfem: error: run: failed: IDA" err.txt || { echo "FAIL message: $(cat err.txt)"; fail=1; }
+grep -q "rfem: error: run: failed: " err.txt || { echo "FAIL message: $(cat err.txt)"; fail=1; }
 [ "$(wc -l <err.txt)" = 1 ] || { echo "FAIL: more than one line on stderr"; fail=1; }
-check tol.h5 run "failed: IDA" || fail=1
+check tol.h5 run "failed: " || fail=1
 [ $fail = 0 ] && echo "3 passed, 0 failed" || echo "failures above"
 exit $fail

@@ -13,8 +13,18 @@
 using namespace rfem;
 
 namespace {
+// Parallel paths on every chunk size that matters: chunks of 2 rfes put chunk boundaries between
+// most sdes of a small model.
+Workspace workspace(int threads, int chunk = 2) {
+  Workspace ws;
+  ws.parallel.threads = threads;
+  ws.parallel.min_rfes = 1;
+  ws.parallel.chunk = chunk;
+  return ws;
+}
+
 std::vector<double> newton_values(const Model& m, const BorderedPattern& p, const VecX& q, const VecX& v, int threads) {
-  omp_set_num_threads(threads);
+  Workspace ws = workspace(threads);
   std::vector<int> cols(m.m());
   for (int j = 0; j < m.m(); ++j) cols[j] = 6 * m.n() + j;
   MatrixTerms t;
@@ -23,13 +33,12 @@ std::vector<double> newton_values(const Model& m, const BorderedPattern& p, cons
   t.stiffness = 1.0;
   t.gravity = true;
   std::vector<double> vals;
-  assemble_matrix(m, p, cols, q, v, t, vals);
+  assemble_matrix(m, p, cols, q, v, t, vals, &ws);
   return vals;
 }
 }  // namespace
 
 TEST(Assembly, SparseEqualsDenseReferenceWithOneAndTwoThreads) {
-  set_parallel_min_rfes(1);  // exercise the parallel paths on a small model
   const Model m = test::spatial_arm(7, 0.002);
   VecX q, v, a;
   test::random_state(m, 11, q, v, a);
@@ -44,15 +53,30 @@ TEST(Assembly, SparseEqualsDenseReferenceWithOneAndTwoThreads) {
 }
 
 TEST(Assembly, ForcesIndependentOfThreadCount) {
+  // Forces, dissipation and energies: the same bits with 1 and 2 threads for a given chunk size,
+  // and the same values to round-off for any chunk size (the chunk boundaries lose nothing).
   const Model m = test::spatial_arm(300, 0.001);
   VecX q, v, a;
   test::random_state(m, 12, q, v, a);
-  VecX f1, f2;
-  omp_set_num_threads(1);
-  generalised_forces(m, q, v, a, ForceTerms{}, f1);
-  omp_set_num_threads(2);
-  generalised_forces(m, q, v, a, ForceTerms{}, f2);
-  EXPECT_EQ((f1 - f2).lpNorm<Eigen::Infinity>(), 0.0);
+  q.head(6 * m.n()) *= 0.1;
+  VecX f[2], g;
+  double pd[2], pg;
+  Energies e[2];
+  for (int t : {1, 2}) {
+    Workspace ws = workspace(t, 7);
+    generalised_forces(m, q, v, a, ForceTerms{}, f[t - 1], &pd[t - 1], &ws);
+    e[t - 1] = energies(m, q, v, &ws);
+  }
+  EXPECT_EQ((f[0] - f[1]).lpNorm<Eigen::Infinity>(), 0.0);
+  EXPECT_EQ(pd[0], pd[1]);
+  EXPECT_EQ(e[0].kinetic, e[1].kinetic);
+  EXPECT_EQ(e[0].elastic, e[1].elastic);
+  EXPECT_EQ(e[0].dissipation_rate, e[1].dissipation_rate);
+  Workspace serial = workspace(1, 1000);  // one chunk: no boundaries
+  generalised_forces(m, q, v, a, ForceTerms{}, g, &pg, &serial);
+  EXPECT_LT((f[0] - g).norm(), 1e-12 * g.norm());
+  EXPECT_NEAR(pd[0], pg, 1e-12 * pg);
+  EXPECT_NEAR(pg, e[0].dissipation_rate, 1e-12 * pg) << "dissipation of the force pass = that of energies()";
 }
 
 TEST(Assembly, CholmodSolveEqualsDenseSolve) {
@@ -60,7 +84,7 @@ TEST(Assembly, CholmodSolveEqualsDenseSolve) {
   VecX q, v, a;
   test::random_state(m, 13, q, v, a);
   const BorderedPattern p(m.n(), m.m());
-  const auto vals = newton_values(m, p, q, v, 2);
+  auto vals = newton_values(m, p, q, v, 2);
   CholmodSolver solver(p);
   ASSERT_TRUE(solver.factorize(vals));
   VecX x = a;
@@ -70,8 +94,10 @@ TEST(Assembly, CholmodSolveEqualsDenseSolve) {
 }
 
 TEST(Assembly, PatternHasNoFill) {
-  // The number of stored entries per rfe is fixed (21 own + 36 coupling + 6 per base column),
-  // so storage and factorisation are O(n).
+  // The number of entries per rfe is fixed (21 own + 36 coupling + 6 per base column), so
+  // storage and factorisation are O(n); the block storage holds 72 + 6 nb values per rfe.
   const BorderedPattern a(100, 3), b(200, 3);
-  EXPECT_EQ(b.nnz() - a.nnz(), 100 * (21 + 36 + 18));
+  EXPECT_EQ(b.entries() - a.entries(), 100 * (21 + 36 + 18));
+  EXPECT_EQ(b.nnz() - a.nnz(), 100 * (72 + 18));
+  EXPECT_EQ(static_cast<long>(b.csc().rowind.size()), b.entries());
 }

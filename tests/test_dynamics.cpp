@@ -141,28 +141,36 @@ TEST(Dynamics, KinematicTorquesAsForceInputReproduceTheMotion) {
 }
 
 TEST(Dynamics, OneAndTwoThreadsAgree) {
-  set_parallel_min_rfes(1);  // exercise the parallel paths
+  // Bit-identical trajectories: every parallel path on (chunks of 4 rfes, both sweeps of the chain
+  // solver), with 1 and 2 threads, for both integrators.
   Model m = test::spatial_arm(40);
   m.gravity = 0.0;
-  IntegratorOptions o;  // determinism, not accuracy, is tested: default tolerances
-  o.t_end = 0.3;
-  std::vector<VecX> q1, q2;
-  omp_set_num_threads(1);
-  for (const auto& x : run(m, {free_joint(0, 1.0), free_joint(0, 0.5, 1.0)}, o).s) q1.push_back(x.q);
-  omp_set_num_threads(2);
-  for (const auto& x : run(m, {free_joint(0, 1.0), free_joint(0, 0.5, 1.0)}, o).s) q2.push_back(x.q);
-  ASSERT_EQ(q1.size(), q2.size());
-  for (size_t i = 0; i < q1.size(); ++i) EXPECT_LE((q1[i] - q2[i]).lpNorm<Eigen::Infinity>(), 1e-12) << i;
+  for (IntegratorKind kind : {IntegratorKind::Esdirk, IntegratorKind::Bdf}) {
+    IntegratorOptions o;  // determinism, not accuracy, is tested: default tolerances
+    o.kind = kind;
+    o.t_end = 0.3;
+    o.parallel.min_rfes = 1;
+    o.parallel.chunk = 4;
+    std::vector<VecX> q1, q2;
+    o.parallel.threads = 1;
+    for (const auto& x : run(m, {free_joint(0, 1.0), free_joint(0, 0.5, 1.0)}, o).s) q1.push_back(x.q);
+    o.parallel.threads = 2;
+    for (const auto& x : run(m, {free_joint(0, 1.0), free_joint(0, 0.5, 1.0)}, o).s) q2.push_back(x.q);
+    ASSERT_EQ(q1.size(), q2.size());
+    for (size_t i = 0; i < q1.size(); ++i)
+      EXPECT_EQ((q1[i] - q2[i]).lpNorm<Eigen::Infinity>(), 0.0) << integrator_name(kind) << " output " << i;
+  }
 }
 
 TEST(Dynamics, SchurSolveEqualsDenseSolveOfFullNewtonSystem) {
   const Model m = test::spatial_arm(5, 3e-3);
   VecX q, v, a;
   test::random_state(m, 31, q, v, a);
+  q.head(6 * m.n()) *= 1e-3;  // a physical deformation: the random 5 cm would buckle the axial springs
   const int N = m.dof();
-  NewtonSystem ns(m, {6 * m.n(), 6 * m.n() + 1}, 2);
+  NewtonSystem ns(m, {6 * m.n(), 6 * m.n() + 1}, 2, LinearSolverKind::Chain, nullptr, true);
   const double c = 350.0;
-  ASSERT_TRUE(ns.setup(q, v, c));
+  ASSERT_TRUE(ns.setup(q, v, 1.0 / c));
   const MatX M = dense_mass_matrix(m, q), C = dense_damping(m, q), K = dense_stiffness(m, q, false);
   MatX J = MatX::Zero(2 * N, 2 * N);
   J.topLeftCorner(N, N) = c * MatX::Identity(N, N);
@@ -172,7 +180,37 @@ TEST(Dynamics, SchurSolveEqualsDenseSolveOfFullNewtonSystem) {
   VecX b(2 * N);
   b << a, v;
   VecX x(2 * N);
-  ns.solve(b.data(), x.data());
+  ns.solve_bdf(b.data(), x.data());
   const VecX ref = J.fullPivLu().solve(b);
   EXPECT_LT((x - ref).norm() / ref.norm(), 1e-10);
+}
+
+TEST(Dynamics, StaticInitialStateStartsInEquilibrium) {
+  // Joints held still under gravity: started in static equilibrium (the default) the link does not
+  // move and the holding torques are constant; started undeformed it falls into a vibration whose
+  // torque spike at t = 0 grows with n (issue 11: 595 N m against ~60 N m on a two-joint arm).
+  const Model m = test::spatial_arm(12);
+  std::vector<JointInput> hold{law(constant_rate_law(0.3, 0.0)), law(constant_rate_law(-0.4, 0.0))};
+  auto span = [&](InitialState init, double& dq, double& dtau) {
+    IntegratorOptions o = tight(0.5);
+    o.initial = init;
+    const Trace tr = run(m, hold, o);
+    dq = dtau = 0.0;
+    for (const auto& x : tr.s) {
+      dq = std::max(dq, (x.q - tr.s.front().q).lpNorm<Eigen::Infinity>());
+      dtau = std::max(dtau, (x.tau - tr.s.front().tau).lpNorm<Eigen::Infinity>());
+    }
+    return tr.s.front().tau.lpNorm<Eigen::Infinity>();
+  };
+  double dq_s, dtau_s, dq_u, dtau_u;
+  const double tau = span(InitialState::Static, dq_s, dtau_s);
+  span(InitialState::Undeformed, dq_u, dtau_u);
+  RecordProperty("static_torque_change", std::to_string(dtau_s / tau));
+  RecordProperty("undeformed_torque_change", std::to_string(dtau_u / tau));
+  // At rest in equilibrium: changes at the integrator's tolerance (rtol 1e-8) only.
+  EXPECT_LT(dtau_s, 1e-6 * tau);
+  EXPECT_LT(dq_s, 1e-8);
+  // Undeformed: the sag develops (mm) and the torques swing by a sizeable fraction.
+  EXPECT_GT(dq_u, 1e-4);
+  EXPECT_GT(dtau_u, 1e-2 * tau);
 }

@@ -8,8 +8,8 @@ namespace rfem::test {
 
 std::string source_path(const std::string& rel) { return std::string(TEST_SOURCE_DIR) + "/" + rel; }
 
-Model spatial_arm(int n, double beta) {
-  Material al{"al", 7e10, 2.7e10, 2700};
+Model spatial_arm(int n, double beta, double stiffness) {
+  Material al{"al", 7e10 * stiffness, 2.7e10 * stiffness, 2700};
   Section s1{"s1", 4e-4, 2e-7, 3e-7, 3.5e-7, 0.8, 0.7, Vec3::Zero()};
   Section s2{"s2", 1e-4, 5e-9, 8e-9, 1e-8, 0.6, 0.5, Vec3(0, 0.01, -0.005)};
   FlexibleLink link;

@@ -7,7 +7,8 @@ Writes PNGs into OUTDIR (default: the directory of RESULT.h5):
   * for every run group G: G_joints.png, G_tip.png, G_energy.png;
   * for procedure "paper": fig5_tip.png, fig6_torque3.png, fig7_velocity3.png, fig8_accel12.png
     (the layout of the paper's Figures 5-8);
-  * for a file with a `refine` group: refine_convergence.png.
+  * for a file with a `refine` group: refine_convergence.png (and refine_convergence_qK.png for
+    every further quantity K).
 Needs Debian's python3-matplotlib, python3-h5py and python3-numpy (run with /usr/bin/python3).
 """
 import argparse
@@ -42,28 +43,56 @@ def wrap(text):
     return textwrap.fill(text, 75)
 
 
+def list_attr(obj, name):
+    """An array-of-strings attribute as a list of str."""
+    value = obj.attrs.get(name)
+    if value is None:
+        return []
+    if isinstance(value, (str, bytes)):
+        value = [value]
+    return [v.decode("utf-8", "replace") if isinstance(v, bytes) else str(v) for v in np.asarray(value).ravel()]
+
+
 class Run:
     """The series of one run group, read into memory."""
 
-    def __init__(self, group, name):
+    def __init__(self, group, name, case=""):
         self.name = name
+        self.case = case
         self.status = text_attr(group, "status", "unknown")
-        joints = text_attr(group, "joints")
+        self.n = int(np.asarray(group.attrs.get("n", -1)).ravel()[0])
         self.t = group["time"][:, 0]
         self.data = {key: np.asarray(group[key][:]) for key in SERIES
                      if key in group and group[key].ndim == 2
                      and group[key].shape[0] == len(self.t)}
         ncols = self.data["joint_q"].shape[1] if "joint_q" in self.data else 0
-        self.joints = joints.split(",") if joints else []
+        self.joints = list_attr(group, "joint_names")
         if len(self.joints) != ncols:
             self.joints = ["joint %d" % (j + 1) for j in range(ncols)]
+        self.types = list_attr(group, "joint_types")
+        if len(self.types) != ncols:
+            self.types = ["revolute"] * ncols
 
     def col(self, key, j):
         return self.data[key][:, j]
 
     def title(self, what):
+        head = "%s%s, %s" % (self.case + " " if self.case else "", self.name, "n = %d" % self.n if self.n >= 0 else "")
         suffix = "" if self.status == "completed" else "\n" + wrap("[status: %s]" % self.status)
-        return "%s: %s%s" % (self.name, what, suffix)
+        return "%s: %s%s" % (head, what, suffix)
+
+
+def negligible(y, scale):
+    """True for a series that is identically zero or round-off against `scale`."""
+    peak = np.max(np.abs(y)) if len(y) else 0.0
+    return peak == 0.0 or peak < 1e-12 * max(scale, 1e-300)
+
+
+def mean_acceleration(t, v):
+    """(v[k+1] − v[k−1]) / (t[k+1] − t[k−1]): the mean over two output intervals (README)."""
+    if len(t) < 3:
+        return t, v
+    return t[1:-1], (v[2:] - v[:-2]) / (t[2:] - t[:-2])[:, None] if v.ndim == 2 else (v[2:] - v[:-2]) / (t[2:] - t[:-2])
 
 
 def save(fig, outdir, name):
@@ -83,33 +112,42 @@ def finish(ax, xlabel=None, ylabel=None, legend=True):
         ax.legend(loc="best", fontsize="small")
 
 
+UNITS = {"revolute": ("rad", "rad/s", "N m"), "prismatic": ("m", "m/s", "N")}
+
+
 def plot_run(run, outdir):
     """G_joints.png, G_tip.png, G_energy.png for one run group."""
     g = run.name
-    # Joints: q, v, tau.
-    panels = [("joint_q", "q [rad or m]"), ("joint_v", "v [rad/s or m/s]"),
-              ("joint_tau", "τ [N m or N]")]
-    panels = [p for p in panels if p[0] in run.data]
-    if panels:
-        fig, axes = plt.subplots(len(panels), 1, sharex=True, figsize=(8, 2.6 * len(panels) + 0.8),
-                                 squeeze=False)
-        for ax, (key, ylabel) in zip(axes[:, 0], panels):
+    # Joints: q, v, tau — revolute and prismatic joints on separate axes (their units differ).
+    kinds = [k for k in ("revolute", "prismatic") if k in run.types]
+    rows = [(key, k) for key in ("joint_q", "joint_v", "joint_tau") if key in run.data for k in kinds]
+    if rows:
+        fig, axes = plt.subplots(len(rows), 1, sharex=True, figsize=(8, 2.4 * len(rows) + 0.8), squeeze=False)
+        for ax, (key, kind) in zip(axes[:, 0], rows):
+            unit = UNITS[kind][("joint_q", "joint_v", "joint_tau").index(key)]
+            sym = {"joint_q": "q", "joint_v": "v", "joint_tau": "τ"}[key]
             for j, name in enumerate(run.joints):
-                ax.plot(run.t, run.col(key, j), label=name)
-            finish(ax, ylabel=ylabel)
+                if run.types[j] == kind:
+                    ax.plot(run.t, run.col(key, j), label=name)
+            finish(ax, ylabel="%s [%s]" % (sym, unit))
         axes[-1, 0].set_xlabel("t [s]")
         axes[0, 0].set_title(run.title("joint coordinates, rates and torques"))
         fig.tight_layout()
         save(fig, outdir, "%s_joints.png" % g)
     # Tip deflections.
     if "tip_deflection" in run.data:
+        td = run.data["tip_deflection"]
+        scale = np.max(np.abs(td[:, :2])) if td.size else 0.0
         fig, axes = plt.subplots(3, 1, sharex=True, figsize=(8, 7))
         for j, (ax, (name, ylabel)) in enumerate(zip(axes, TIP_LABELS)):
-            y = run.col("tip_deflection", j)
-            ax.plot(run.t, y, label=name, color="C%d" % j)
-            if not np.any(y):
-                ax.text(0.5, 0.75, "identically zero", transform=ax.transAxes, ha="center",
-                        color="0.4")
+            y = td[:, j]
+            if negligible(y, scale if j < 2 else max(scale, np.max(np.abs(y)) * 1e13)):
+                ax.axhline(0.0, color="C%d" % j, label=name)
+                ax.text(0.5, 0.6, "identically zero" if not np.any(y) else
+                        "round-off only (|%s| ≤ %.1e)" % (name, np.max(np.abs(y))),
+                        transform=ax.transAxes, ha="center", color="0.35")
+            else:
+                ax.plot(run.t, y, label=name, color="C%d" % j)
             finish(ax, ylabel=ylabel)
         axes[-1].set_xlabel("t [s]")
         axes[0].set_title(run.title("tip deflections u1, u2 and torsion θ"))
@@ -133,10 +171,10 @@ def plot_run(run, outdir):
         save(fig, outdir, "%s_energy.png" % g)
 
 
-def compare(ax, runs_cols, ylabel, xlabel=None):
-    """Plot (run, key, column, label) series on one axis."""
-    for k, (run, key, j, label) in enumerate(runs_cols):
-        ax.plot(run.t, run.col(key, j), label=label, linestyle="-" if k == 0 else "--")
+def compare(ax, runs_series, ylabel, xlabel=None):
+    """Plot (t, y, label) series on one axis."""
+    for k, (t, y, label) in enumerate(runs_series):
+        ax.plot(t, y, label=label, linestyle="-" if k == 0 else "--")
     finish(ax, xlabel, ylabel)
 
 
@@ -148,75 +186,114 @@ def status_note(*runs):
 def plot_paper(runs, outdir):
     """The paper's Figures 5-8 from the rigid, kinematic and force groups."""
     rig, kin, frc = runs["rigid"], runs["kinematic"], runs["force"]
+    head = "%sn = %d: " % (kin.case + ", " if kin.case else "", kin.n)
     # Fig. 5: tip deflections, kinematic vs force input.
     fig, axes = plt.subplots(3, 1, sharex=True, figsize=(8, 7.5))
     for j, (ax, (_, ylabel)) in enumerate(zip(axes, TIP_LABELS)):
-        compare(ax, [(kin, "tip_deflection", j, "1: kinematic input"),
-                     (frc, "tip_deflection", j, "2: force input")], ylabel)
+        compare(ax, [(kin.t, kin.col("tip_deflection", j), "kinematic input"),
+                     (frc.t, frc.col("tip_deflection", j), "force input")], ylabel)
     axes[-1].set_xlabel("t [s]")
-    axes[0].set_title("Fig. 5: tip deflections u1, u2 and torsion θ of link 3"
-                      + status_note(kin, frc))
+    axes[0].set_title(head + "Fig. 5: tip deflections u1, u2 and torsion θ of link 3" + status_note(kin, frc))
     fig.tight_layout()
     save(fig, outdir, "fig5_tip.png")
     # Fig. 6: joint-3 torque, rigid vs flexible link.
     fig, ax = plt.subplots(figsize=(8, 4.5))
-    compare(ax, [(rig, "joint_tau", 2, "rigid link 3"),
-                 (kin, "joint_tau", 2, "flexible link 3 (kinematic input)")],
-            "τ3 [N m]", "t [s]")
-    ax.set_title("Fig. 6: joint-3 torque, rigid vs flexible link" + status_note(rig, kin))
+    compare(ax, [(rig.t, rig.col("joint_tau", 2), "rigid link 3"),
+                 (kin.t, kin.col("joint_tau", 2), "flexible link 3 (kinematic input)")], "τ3 [N m]", "t [s]")
+    ax.set_title(head + "Fig. 6: joint-3 torque, rigid vs flexible link" + status_note(rig, kin))
     fig.tight_layout()
     save(fig, outdir, "fig6_torque3.png")
     # Fig. 7: joint-3 velocity, kinematic vs force input.
     fig, ax = plt.subplots(figsize=(8, 4.5))
-    compare(ax, [(kin, "joint_v", 2, "1: kinematic input"),
-                 (frc, "joint_v", 2, "2: force input")], "dψ3/dt [rad/s]", "t [s]")
-    ax.set_title("Fig. 7: joint-3 velocity" + status_note(kin, frc))
+    compare(ax, [(kin.t, kin.col("joint_v", 2), "kinematic input"),
+                 (frc.t, frc.col("joint_v", 2), "force input")], "dψ3/dt [rad/s]", "t [s]")
+    ax.set_title(head + "Fig. 7: joint-3 velocity" + status_note(kin, frc))
     fig.tight_layout()
     save(fig, outdir, "fig7_velocity3.png")
-    # Fig. 8: joint 1 and 2 accelerations, kinematic vs force input.
+    # Fig. 8: joint 1 and 2 accelerations, kinematic vs force input, as means over two output
+    # intervals: the instantaneous acceleration of a free joint carries an unresolved stiff mode.
     fig, axes = plt.subplots(2, 1, sharex=True, figsize=(8, 6.5))
+    tk, ak = mean_acceleration(kin.t, kin.data["joint_v"])
+    tf, af = mean_acceleration(frc.t, frc.data["joint_v"])
     for j, ax in enumerate(axes):
-        compare(ax, [(kin, "joint_a", j, "1: kinematic input"),
-                     (frc, "joint_a", j, "2: force input")], "d²ψ%d/dt² [rad/s²]" % (j + 1))
-        ax.set_title("joint %d" % (j + 1), fontsize="medium")
+        compare(ax, [(tk, ak[:, j], "kinematic input"), (tf, af[:, j], "force input")],
+                "d²ψ%d/dt² [rad/s²]" % (j + 1))
+        ax.set_title("joint %d (mean over two output intervals)" % (j + 1), fontsize="medium")
     axes[-1].set_xlabel("t [s]")
-    fig.suptitle("Fig. 8: joint 1 and 2 accelerations" + status_note(kin, frc))
+    fig.suptitle(head + "Fig. 8: joint 1 and 2 accelerations" + status_note(kin, frc))
     fig.tight_layout()
     save(fig, outdir, "fig8_accel12.png")
 
 
-def plot_refine(group, outdir):
-    """|value - reference| (or successive differences) against n, log-log, with fitted slope."""
-    n = np.asarray(group["n"][:], dtype=float).ravel()
-    v = np.asarray(group["value"][:], dtype=float).ravel()
-    quantity = text_attr(group, "quantity", "value")
-    if "reference" in group.attrs:
-        ref = float(np.asarray(group.attrs["reference"]).ravel()[0])
-        x, err = n, np.abs(v - ref)
-        label, ylabel = "|value − reference|", "|%s − reference|" % quantity
-        note = "reference (Richardson) = %.10g" % ref
-    else:
-        x, err = n[1:], np.abs(np.diff(v))
-        label, ylabel = "|value[i] − value[i−1]|", "|Δ %s|" % quantity
-        note = "no reference: successive differences"
-    keep = (err > 0) & (x > 0) & np.isfinite(err)
-    x, err = x[keep], err[keep]
-    fig, ax = plt.subplots(figsize=(7, 5))
-    ax.loglog(x, err, "o-", label=label)
-    if len(x) >= 2:
-        lx, ly = np.log(x[-3:]), np.log(err[-3:])
-        slope, icpt = np.polyfit(lx, ly, 1)
-        xs = np.exp(np.linspace(lx[0], lx[-1], 20))
-        ax.loglog(xs, np.exp(icpt) * xs ** slope, "k--",
-                  label="fit, last %d points: slope %.2f" % (len(lx), slope))
-    finish(ax, "n (number of rfes)", ylabel)
-    ax.grid(True, which="minor", alpha=0.15)
-    ax.set_xticks(x)
-    ax.set_xticklabels(["%g" % v for v in x])
-    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-    ax.set_title("Refinement study: %s\n%s" % (quantity, note), fontsize="medium")
-    fig.tight_layout()
-    save(fig, outdir, "refine_convergence.png")
+def quantity_unit(q):
+    """The unit of a refine quantity (see README, rfem refine)."""
+    name = q.split("/")[-1]
+    if name.startswith(("mode:", "axial:", "bending-", "torsion:")):
+        return "Hz"
+    if name.startswith("tip:"):
+        return "m" if name[4:5] == "u" else "rad"
+    body = name.split(":")[-1].split("@")[0]
+    if body in ("u1", "u2"):
+        return "m"
+    if body == "theta":
+        return "rad"
+    if body.startswith("tau"):
+        return "N m or N"
+    if body.startswith("q"):
+        return "rad or m"
+    return ""
+
+
+def plot_refine(group, outdir, case_name=""):
+    """Per quantity: |value − Richardson value| (when the series is trusted) or the successive
+    changes, against n on log–log axes, with a line of the order fitted by least squares over all
+    changes (independent of the extrapolation)."""
+    n_all = np.asarray(group["n"][:], dtype=float).ravel()
+    subs = sorted((k for k in group if k.startswith("q") and isinstance(group[k], h5py.Group)),
+                  key=lambda k: int(k[1:])) or [None]
+    status = text_attr(group, "status", "completed")
+    for sub in subs:
+        g = group[sub] if sub else group
+        v = np.asarray(g["value"][:], dtype=float).ravel()
+        n = n_all[:len(v)]
+        quantity = text_attr(g, "quantity", "value")
+        unit = quantity_unit(quantity)
+        warnings = text_attr(g, "warnings", "")
+        fitted = float(np.asarray(g.attrs.get("fitted_order", np.nan)).ravel()[0])
+        if "reference" in g.attrs:
+            ref = float(np.asarray(g.attrs["reference"]).ravel()[0])
+            x, err = n, np.abs(v - ref)
+            label, ylabel = "|value − Richardson value|", "|%s − reference| [%s]" % (quantity, unit)
+            note = "Richardson value %.10g %s" % (ref, unit)
+        else:
+            x, err = n[1:], np.abs(np.diff(v))
+            label, ylabel = "|change from the previous n|", "|Δ %s| [%s]" % (quantity, unit)
+            note = "no trusted Richardson value: successive changes"
+        keep = (err > 0) & (x > 0) & np.isfinite(err)
+        x, err = x[keep], err[keep]
+        fig, ax = plt.subplots(figsize=(7, 5))
+        if len(x):
+            ax.loglog(x, err, "o-", label=label)
+        changes = np.abs(np.diff(v))
+        if np.isfinite(fitted) and len(changes) and np.all(changes > 0):
+            xs = n[1:]
+            c = np.exp(np.mean(np.log(changes) + fitted * np.log(xs)))
+            ax.loglog(xs, c * xs ** (-fitted), "k--", label="order %.2f (least squares, all changes)" % fitted)
+        finish(ax, "n (number of rfes)", ylabel)
+        ax.grid(True, which="minor", alpha=0.15)
+        if len(x):
+            ax.set_xticks(x)
+            ax.set_xticklabels(["%g" % t for t in x])
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        title = "Refinement study%s: %s\n%s" % (" of " + case_name if case_name else "", quantity, note)
+        if status != "completed":
+            title += " (%s)" % status
+        ax.set_title(title, fontsize="medium")
+        if warnings:
+            ax.text(0.02, 0.02, wrap("warning: " + warnings.replace("\n", "; ")), transform=ax.transAxes,
+                    fontsize="small", color="darkred", va="bottom")
+        fig.tight_layout()
+        save(fig, outdir, "refine_convergence.png" if sub in (None, "q0") else "refine_convergence_%s.png" % sub)
 
 
 def main(argv=None):
@@ -234,18 +311,34 @@ def main(argv=None):
             raise OSError("not an HDF5 file")
         with h5py.File(args.result, "r") as f:
             groups = [k for k in f if isinstance(f[k], h5py.Group)]
-            runs = {k: Run(f[k], k) for k in groups if "time" in f[k]}
+            case = os.path.splitext(os.path.basename(text_attr(f, "case_path")))[0]
+            runs = {k: Run(f[k], k, case) for k in groups if "time" in f[k]}
             has_refine = "refine" in groups and "n" in f["refine"] and "value" in f["refine"]
             if not runs and not has_refine:
                 raise ValueError("no run groups (with a `time` dataset) and no `refine` group")
-            os.makedirs(outdir, exist_ok=True)
+            empty = [k for k, r in runs.items() if len(r.t) == 0]
+            if empty and not has_refine and len(empty) == len(runs):
+                raise ValueError("the run%s %s ha%s no output steps" % ("s" if len(empty) > 1 else "", ", ".join(empty),
+                                                                       "ve" if len(empty) > 1 else "s"))
+            for k in empty:
+                print("rfem plot: note: run %s has no output steps (status: %s)" % (k, runs[k].status), file=sys.stderr)
+                del runs[k]
+            try:
+                os.makedirs(outdir, exist_ok=True)
+                if not os.access(outdir, os.W_OK):
+                    raise OSError("not writable")
+            except OSError as exc:
+                print("rfem plot: error: %s: cannot write the figures there (%s)" % (outdir, exc.strerror or exc),
+                      file=sys.stderr)
+                return 2
             if text_attr(f, "procedure") == "paper" and all(
                     g in runs for g in ("rigid", "kinematic", "force")):
                 plot_paper(runs, outdir)
             for run in runs.values():
                 plot_run(run, outdir)
             if has_refine:
-                plot_refine(f["refine"], outdir)
+                case = text_attr(f, "case_path")
+                plot_refine(f["refine"], outdir, os.path.splitext(os.path.basename(case))[0] if case else "")
     except (OSError, KeyError, ValueError, IndexError, TypeError) as exc:
         reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         print("rfem plot: error: %s: %s" % (args.result, reason), file=sys.stderr)

@@ -1,0 +1,54 @@
+#pragma once
+// What the assembly kernels may use besides their arguments: a thread policy and scratch, owned
+// by the caller (one Workspace per calling thread; the kernels keep no state of their own — the
+// Model/Data split of Pinocchio). Per-rfe loops run over fixed chunks of rfes whose partial sums
+// are combined in chunk order, so results are the same bits for any number of threads.
+#include <algorithm>
+#include <vector>
+
+#include "core/kinematics.hpp"
+
+namespace rfem {
+
+/// How many threads the per-rfe loops use.
+struct Parallelism {
+  int threads = 0;     ///< team size (0: omp_get_max_threads())
+  int min_rfes = 256;  ///< fewer rfes run on one thread: a parallel region costs more than it saves
+  /// rfes per chunk: the unit of work and of partial sums. Results depend on it (summation
+  /// order), never on the thread count; tests make it small to exercise the chunk boundaries.
+  int chunk = 64;
+  /// Team size for a loop over n rfes.
+  int team(int n) const;
+};
+
+/// Σ over bodies of what the base rows need: Y = W H Ẅᵀ (rigid links), G = W H Wᵀ, s = W H e₄,
+/// and the rfes' inertial wrench about the origin of {0} (force f, moment n).
+struct BaseMoments {
+  Mat4 Y = Mat4::Zero(), G = Mat4::Zero();
+  Vec4 s = Vec4::Zero();
+  Vec3 f = Vec3::Zero(), n = Vec3::Zero();
+  BaseMoments& operator+=(const BaseMoments& o) {
+    Y += o.Y;
+    G += o.G;
+    s += o.s;
+    f += o.f;
+    n += o.n;
+    return *this;
+  }
+};
+
+struct Workspace {
+  Parallelism parallel;
+  BaseKinematics bk;
+  std::vector<BaseMoments> moments;  ///< per chunk
+  std::vector<double> power;         ///< per chunk: sde dissipation
+  std::vector<Vec6> boundary;        ///< per chunk: its first sde's force on the previous chunk's last rfe
+  std::vector<Mat6> boundary_block;  ///< per chunk (and target): the same sde's block on that rfe
+  VecX zero;                         ///< zeros of the model's size
+  /// Sizes the chunk arrays for n rfes (cleared) and returns the number of chunks.
+  int chunks(int n);
+  int chunk_begin(int c) const { return c * parallel.chunk; }
+  int chunk_end(int c, int n) const { return std::min(n, (c + 1) * parallel.chunk); }
+};
+
+}  // namespace rfem

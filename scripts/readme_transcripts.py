@@ -1,0 +1,75 @@
+#!/usr/bin/python3
+"""README transcripts: every block of README.md that follows a marker
+
+    <!-- transcript -->
+    ```
+    $ build/apps/rfem modes cases/kane_beam.toml --count 6
+    …the output…
+    ```
+
+is the real output of its command (stdout; run from the repository root with the given rfem). Checks
+them (exit 1 with a diff on a mismatch) or, with --update, rewrites them.
+
+    /usr/bin/python3 scripts/readme_transcripts.py [--rfem build/apps/rfem] [--update]
+"""
+import argparse
+import difflib
+import os
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BLOCK = re.compile(r"(<!-- transcript -->\n```\n\$ (?P<cmd>[^\n]+)\n)(?P<out>.*?)(```)", re.S)
+
+
+def run(cmd, rfem, scratch):
+    args = shlex.split(cmd)
+    if args[0] == "build/apps/rfem":
+        args[0] = rfem
+    # In a scratch directory that sees the repository's cases/: results files land there.
+    env = dict(os.environ, OMP_WAIT_POLICY="PASSIVE")
+    p = subprocess.run(args, cwd=scratch, capture_output=True, text=True, env=env)
+    if p.returncode != 0:
+        sys.exit(f"readme_transcripts: `{cmd}` exited {p.returncode}: {p.stderr.strip()}")
+    return p.stdout
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--rfem", default=os.path.join(ROOT, "build", "apps", "rfem"))
+    ap.add_argument("--update", action="store_true")
+    args = ap.parse_args()
+    path = os.path.join(ROOT, "README.md")
+    text = open(path).read()
+    scratch = tempfile.mkdtemp(prefix="rfem-readme-")
+    os.symlink(os.path.join(ROOT, "cases"), os.path.join(scratch, "cases"))
+    bad = 0
+    out = []
+    pos = 0
+    for m in BLOCK.finditer(text):
+        got = run(m.group("cmd"), os.path.abspath(args.rfem), scratch)
+        out.append(text[pos:m.start("out")])
+        out.append(got)
+        pos = m.end("out")
+        if got != m.group("out"):
+            bad += 1
+            if not args.update:
+                sys.stdout.writelines(difflib.unified_diff(m.group("out").splitlines(True), got.splitlines(True),
+                                                           "README.md", m.group("cmd")))
+    out.append(text[pos:])
+    shutil.rmtree(scratch, ignore_errors=True)
+    n = len(BLOCK.findall(text))
+    if args.update:
+        open(path, "w").write("".join(out))
+        print(f"readme_transcripts: {n} transcripts, {bad} updated")
+        return 0
+    print(f"readme_transcripts: {n} transcripts, {bad} differ" + ("" if bad == 0 else ": run with --update"))
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

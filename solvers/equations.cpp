@@ -1,0 +1,170 @@
+#include "solvers/equations.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+#include <string>
+
+#include "solvers/mass_solve.hpp"
+#include "solvers/statics.hpp"
+
+namespace rfem {
+
+EquationsOfMotion::EquationsOfMotion(const Model& model, const std::vector<JointInput>& inputs,
+                                     const ForceTerms& terms, const std::atomic<int>* stop, LinearSolverKind solver,
+                                     const Parallelism& parallel, bool keep_stiffness)
+    : model_(model),
+      inputs_(inputs),
+      stop_(stop),
+      terms_(terms),
+      governor_(model.n() >= parallel.min_rfes ? (parallel.threads > 0 ? parallel.threads : omp_get_max_threads()) : 1,
+                parallel.threads > 0),
+      damped_(model.link.damping_beta > 0) {
+  ws_.parallel = parallel;
+  ws_.parallel.threads = governor_.threads();
+  if (static_cast<int>(inputs.size()) != model.m()) throw std::invalid_argument("one input per joint is required");
+  const int n6 = 6 * model.n();
+  for (int i = 0; i < n6; ++i) unknown_.push_back(i);
+  base_col_.assign(model.m(), -1);
+  int nb = 0;
+  for (int j = 0; j < model.m(); ++j)
+    if (!inputs[j].prescribed()) {
+      base_col_[j] = static_cast<int>(unknown_.size());
+      unknown_.push_back(model.base_index(j));
+      ++nb;
+    }
+  newton_ = std::make_unique<NewtonSystem>(model, base_col_, nb, solver, &ws_, keep_stiffness);
+}
+
+void EquationsOfMotion::expand(double t, const double* qu, const double* vu, const double* au) {
+  const int N = model_.dof(), u = unknowns();
+  q_.setZero(N);
+  v_.setZero(N);
+  a_.setZero(N);
+  for (int i = 0; i < u; ++i) {
+    q_[unknown_[i]] = qu[i];
+    v_[unknown_[i]] = vu[i];
+    if (au) a_[unknown_[i]] = au[i];
+  }
+  for (int j = 0; j < model_.m(); ++j)
+    if (inputs_[j].prescribed()) {
+      const MotionSample s = inputs_[j].motion->at(t);
+      const int k = model_.base_index(j);
+      q_[k] = s.q;
+      v_[k] = s.qd;
+      a_[k] = s.qdd;
+    }
+}
+
+VecX EquationsOfMotion::torques(double t) const {
+  VecX tau(model_.m());
+  for (int j = 0; j < model_.m(); ++j)
+    tau[j] = inputs_[j].prescribed() ? F_[model_.base_index(j)] : inputs_[j].torque->at(t);
+  return tau;
+}
+
+Power EquationsOfMotion::residual(double t, const double* qu, const double* vu, const double* au, double* r) {
+  const auto start = std::chrono::steady_clock::now();
+  expand(t, qu, vu, au);
+  Power p;
+  generalised_forces(model_, q_, v_, a_, terms_, F_, damped_ ? &p.dissipation : nullptr, &ws_);
+  if (!by_steps_) {
+    governor_.record(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    ws_.parallel.threads = governor_.threads();
+  }
+  const VecX tau = torques(t);
+  const int u = unknowns(), m = model_.m();
+  for (int i = 0; i < u; ++i) r[i] = F_[unknown_[i]];
+  for (int j = 0; j < m; ++j)
+    if (base_col_[j] >= 0) r[base_col_[j]] -= tau[j];
+  p.input = tau.dot(v_.tail(m));
+  return p;
+}
+
+Power EquationsOfMotion::power_change(double t, const double* vu, const VecX& da, double hg) {
+  Power d;
+  const MatX& rows = newton_->base_rows();
+  for (int j = 0; j < model_.m(); ++j) {
+    if (inputs_[j].prescribed()) d.input += inputs_[j].motion->at(t).qd * rows.row(j).dot(da);
+    else d.input += inputs_[j].torque->at(t) * hg * da[base_col_[j]];
+  }
+  if (damped_) {
+    VecX Cda;
+    newton_->damping_times(da, Cda);
+    d.dissipation = 2.0 * hg * Eigen::Map<const VecX>(vu, unknowns()).dot(Cda);
+  }
+  return d;
+}
+
+VecX EquationsOfMotion::accelerations(double t, const double* qu, const double* vu) {
+  const int u = unknowns();
+  VecX rhs(u);
+  residual(t, qu, vu, nullptr, rhs.data());
+  rhs = -rhs;
+  if (!solve_mass(model_, newton_->pattern(), base_col_, q_, v_, rhs, mass_values_))
+    throw std::runtime_error("the mass matrix is not positive definite at t = " + std::to_string(t) + " s");
+  std::vector<double>().swap(mass_values_);  // needed once or at output times: do not keep it
+  return rhs;
+}
+
+OutputSample EquationsOfMotion::sample(double t, const double* qu, const double* vu, const double* au,
+                                       double dissipated, double input_work) {
+  const VecX a = au ? Eigen::Map<const VecX>(au, unknowns()).eval()
+                    : (unknowns() > 0 ? accelerations(t, qu, vu) : VecX());
+  VecX r(unknowns());
+  residual(t, qu, vu, a.data(), r.data());  // F at these accelerations: the required torques
+  OutputSample s;
+  s.t = t;
+  s.q = q_;
+  s.v = v_;
+  s.a = a_;
+  s.tau = torques(t);
+  s.energy = energies(model_, q_, v_, &ws_);
+  s.dissipated = dissipated;
+  s.input_work = input_work;
+  return s;
+}
+
+void EquationsOfMotion::report_step(double seconds, long residuals) {
+  if (residuals <= 0) return;
+  governor_.record(seconds / residuals);
+  ws_.parallel.threads = governor_.threads();
+}
+
+bool EquationsOfMotion::setup_newton(double t, const double* qu, const double* vu, double h) {
+  expand(t, qu, vu, nullptr);
+  return newton_->setup(q_, v_, h);
+}
+
+std::vector<double> EquationsOfMotion::breakpoints(double t_end) const {
+  std::vector<double> b;
+  for (const auto& in : inputs_)
+    for (double x : in.breakpoints())
+      if (x > 0.0 && x < t_end) b.push_back(x);
+  std::sort(b.begin(), b.end());
+  b.erase(std::unique(b.begin(), b.end(), [](double x, double y) { return y - x <= 1e-12 * std::max(1.0, y); }), b.end());
+  return b;
+}
+
+void EquationsOfMotion::initial_state(VecX& qu, VecX& vu, bool static_equilibrium) const {
+  qu = VecX::Zero(unknowns());
+  vu = VecX::Zero(unknowns());
+  for (int j = 0; j < model_.m(); ++j)
+    if (base_col_[j] >= 0) {
+      qu[base_col_[j]] = inputs_[j].q0;
+      vu[base_col_[j]] = inputs_[j].v0;
+    }
+  if (!static_equilibrium || model_.n() == 0) return;
+  VecX qb(model_.m()), vb(model_.m());
+  for (int j = 0; j < model_.m(); ++j) {
+    const bool law = inputs_[j].prescribed();
+    qb[j] = law ? inputs_[j].motion->at(0.0).q : inputs_[j].q0;
+    vb[j] = law ? inputs_[j].motion->at(0.0).qd : inputs_[j].v0;
+  }
+  const StaticResult eq = solve_static(model_, qb, vb, TipLoads{});
+  qu.head(6 * model_.n()) = eq.q.head(6 * model_.n());
+}
+
+}  // namespace rfem

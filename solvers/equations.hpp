@@ -1,0 +1,102 @@
+#pragma once
+// The equations of motion over the unknown coordinates (FORMULATION.md §5): the 6n rfe
+// coordinates and the joints under force input. With full q, v, a built from the unknowns and the
+// laws of prescribed joints,
+//   r_u(t, q_u, v_u, a_u) = F_u(q, v, a) − τ_u(t),   F = M(q) a + h(q, v) + f_el + f_g + f_d,
+// and the required torques of prescribed joints are the base rows of F (inverse dynamics).
+// Shared by every time integrator; owns the Newton system on the unknowns' bordered pattern.
+#include <atomic>
+#include <memory>
+
+#include "assembly/assemble.hpp"
+#include "solvers/inputs.hpp"
+#include "solvers/newton_system.hpp"
+#include "solvers/thread_governor.hpp"
+
+namespace rfem {
+
+/// One output step: full coordinates, the torque of every joint (applied or required) and energies.
+struct OutputSample {
+  double t = 0.0;
+  VecX q, v, a;   ///< full coordinates (flexible first, base last)
+  VecX tau;       ///< joint torques/forces [N m or N], applied (force input) or required (kinematic)
+  Energies energy;
+  double dissipated = 0.0, input_work = 0.0;  ///< integrals since t = 0 [J]
+  long steps = 0;        ///< integrator steps taken so far (for progress reports)
+  double last_step = 0;  ///< the integrator's last step size [s]
+};
+
+/// Power flows of one state: what the energy integrals integrate.
+struct Power {
+  double dissipation = 0.0;  ///< sde damping [W]
+  double input = 0.0;        ///< τ · q̇_b of every joint [W]
+};
+
+class EquationsOfMotion {
+ public:
+  EquationsOfMotion(const Model& model, const std::vector<JointInput>& inputs, const ForceTerms& terms,
+                    const std::atomic<int>* stop, LinearSolverKind solver = LinearSolverKind::Chain,
+                    const Parallelism& parallel = {}, bool keep_stiffness = false);
+  const Model& model() const { return model_; }
+  /// Number of unknown coordinates (size of q_u).
+  int unknowns() const { return static_cast<int>(unknown_.size()); }
+  /// Full coordinate index of unknown i.
+  int unknown_index(int i) const { return unknown_[i]; }
+  /// Joint j's column among the unknowns, −1 if prescribed.
+  const std::vector<int>& base_col() const { return base_col_; }
+  bool stop_requested() const { return stop_ && stop_->load(); }
+  int stop_signal() const { return stop_ ? stop_->load() : 0; }
+
+  /// Full q, v, a at t from the unknowns and the prescribed laws (a_u = 0 if `au` is null).
+  void expand(double t, const double* qu, const double* vu, const double* au);
+  /// r_u at (t, q_u, v_u, a_u); returns the power flows of that state.
+  Power residual(double t, const double* qu, const double* vu, const double* au, double* r);
+  /// First-order change of a state's power flows when its accelerations move by δa_u at fixed
+  /// Q_u = Q + hγ² δa, V_u = V + hγ δa (the last Newton update of an ESDIRK stage): required
+  /// torques change by the mass rows M_bu δa, velocities by hγ δa, damping power by 2 Vᵀ C hγ δa.
+  /// Uses the Newton system's last mass and damping.
+  Power power_change(double t, const double* vu, const VecX& da, double hg);
+  /// Accelerations of the unknowns from the equations at a state: M_uu a_u = τ_u − F_u(a_u = 0),
+  /// by block elimination (O(n)). Throws if M is not positive definite.
+  VecX accelerations(double t, const double* qu, const double* vu);
+  /// A complete output sample at a state: torques (inverse dynamics with the accelerations au, or,
+  /// if au is null, with those of the equations at that state), energies.
+  OutputSample sample(double t, const double* qu, const double* vu, const double* au, double dissipated,
+                      double input_work);
+  /// The inputs' breakpoints inside (0, t_end), sorted, without duplicates.
+  std::vector<double> breakpoints(double t_end) const;
+  /// Initial unknowns: free joints at their initial values and rates, rfes at rest relative to {r}
+  /// and undeformed, or (`static_equilibrium`) in the static equilibrium of the initial joint values
+  /// and rates. Throws std::runtime_error if that equilibrium cannot be found.
+  void initial_state(VecX& qu, VecX& vu, bool static_equilibrium = false) const;
+
+  NewtonSystem& newton() { return *newton_; }
+  /// The thread policy of every kernel the equations run (results do not depend on it). With
+  /// threads = 0 a ThreadGovernor picks one thread or all by timing the residual evaluations.
+  const Parallelism& parallelism() const { return ws_.parallel; }
+  const ThreadGovernor& governor() const { return governor_; }
+  /// The integrator times whole steps (`seconds`, `residuals` evaluated in them) for the governor
+  /// instead of single residual evaluations.
+  void govern_by_steps() { by_steps_ = true; }
+  void report_step(double seconds, long residuals);
+  /// Assembles and factorises the Newton matrix S(h) at a state. False if not positive definite.
+  bool setup_newton(double t, const double* qu, const double* vu, double h);
+  /// Joint torques of the last evaluated state: applied (force input) or required (kinematic).
+  VecX torques(double t) const;
+
+ private:
+  const Model& model_;
+  const std::vector<JointInput>& inputs_;
+  const std::atomic<int>* stop_;
+  ForceTerms terms_;
+  Workspace ws_;
+  ThreadGovernor governor_;
+  bool by_steps_ = false;
+  std::vector<int> unknown_, base_col_;
+  std::unique_ptr<NewtonSystem> newton_;
+  std::vector<double> mass_values_;
+  VecX q_, v_, a_, F_;
+  bool damped_;
+};
+
+}  // namespace rfem

@@ -1,0 +1,365 @@
+// ESDIRK time integration of the second-order equations r(t, q, v, a) = 0 (solvers/equations.hpp).
+//
+// An s-stage ESDIRK method (A lower triangular, a_00 = 0, a_ii = γ for i ≥ 1, stiffly accurate:
+// b = last row of A) applied to q' = v, v' = a, written in the stage accelerations α_i:
+//   V_i = v_n + h Σ_j a_ij α_j,   Q_i = q_n + c_i h v_n + h² Σ_j (A²)_ij α_j,
+//   r(t_n + c_i h, Q_i, V_i, α_i) = 0        (i = 1 … s−1; α_0 = a_n, the previous last stage).
+// The q-equation is satisfied exactly, so each stage is a Newton iteration on α_i alone with the
+// matrix ∂r/∂a + hγ ∂r/∂v + (hγ)² ∂r/∂q ≈ S = M + hγ C + (hγ)² K: the bordered symmetric positive
+// definite matrix of the Newton system (solvers/newton_system.hpp), assembled and factorised once per
+// step and shared by its stages.
+// L-stability and stiff accuracy damp the undamped stiff sde modes (ω up to ~1e5 rad/s) that the
+// steps do not resolve; the tables whose embedded method is L-stable too (ESDIRK436L2SA,
+// ESDIRK43I6L2SA, ESDIRK437L2SA) keep those modes out of the error estimate as well.
+// Error estimate: the embedded solution (weights d): e_v = h Σ (b−d)_j α_j,
+// e_q = h² Σ ((b−d)ᵀA)_j α_j, in the weighted RMS norm of rtol and atol (IDA's convention).
+// Outputs between steps: quintic Hermite interpolation of q from (q, v, a) at both ends, its first
+// and second derivatives for v and a (the accelerations of the continuous solution).
+#include <cstdio>  // before arkode_butcher.h, which uses FILE without including it
+
+#include <arkode/arkode_butcher_dirk.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "solvers/integrator.hpp"
+
+namespace rfem {
+
+namespace {
+
+struct Tableau {
+  int s = 0, order = 0, embedded_order = 0;
+  MatX A, AA;      // A and A²
+  VecX b, c, eq, ev;  // weights, nodes, error coefficients of q (((b−d)ᵀA)) and v (b − d)
+  double gamma = 0.0;
+};
+
+Tableau load_tableau(const std::string& name) {
+  ARKodeButcherTable B = ARKodeButcherTable_LoadDIRKByName(("ARKODE_" + name).c_str());
+  if (!B) throw std::invalid_argument("unknown ESDIRK table '" + name + "'");
+  Tableau T;
+  T.s = B->stages;
+  T.order = B->q;
+  T.embedded_order = B->p;
+  T.A.resize(T.s, T.s);
+  T.b.resize(T.s);
+  T.c.resize(T.s);
+  VecX d(T.s);
+  for (int i = 0; i < T.s; ++i) {
+    for (int j = 0; j < T.s; ++j) T.A(i, j) = B->A[i][j];
+    T.b[i] = B->b[i];
+    T.c[i] = B->c[i];
+    d[i] = B->d ? B->d[i] : NAN;
+  }
+  ARKodeButcherTable_Free(B);
+  T.gamma = T.A(T.s - 1, T.s - 1);
+  bool ok = T.s >= 2 && T.A(0, 0) == 0.0 && d.allFinite();
+  for (int i = 0; i < T.s && ok; ++i) {
+    for (int j = i + 1; j < T.s; ++j) ok &= T.A(i, j) == 0.0;
+    if (i > 0) ok &= std::abs(T.A(i, i) - T.gamma) < 1e-14;
+    ok &= std::abs(T.A(T.s - 1, i) - T.b[i]) < 1e-14;
+  }
+  if (!ok)
+    throw std::invalid_argument("table '" + name + "' is not an embedded, stiffly accurate ESDIRK method " +
+                                "with an explicit first stage");
+  T.AA = T.A * T.A;
+  T.ev = T.b - d;
+  T.eq = T.A.transpose() * T.ev;
+  return T;
+}
+
+// Weighted max norm of a stage increment δα as the change it makes in [Q; V] = [(hγ)² δα; hγ δα].
+double wmax_increment(const VecX& da, double hg, const VecX& w) {
+  const int u = static_cast<int>(da.size());
+  double s = 0.0;
+  for (int i = 0; i < u; ++i) s = std::max({s, std::abs(hg * hg * da[i] * w[i]), std::abs(hg * da[i] * w[u + i])});
+  return s;
+}
+
+// Weighted RMS norm over [x_q; x_v] with weights w (size 2u).
+double wrms(const VecX& xq, const VecX& xv, const VecX& w) {
+  const int u = static_cast<int>(xq.size());
+  double s = 0.0;
+  for (int i = 0; i < u; ++i) {
+    const double a = xq[i] * w[i], b = xv[i] * w[u + i];
+    s += a * a + b * b;
+  }
+  return std::sqrt(s / std::max(1, 2 * u));
+}
+
+// Quintic Hermite basis on θ ∈ [0, 1] (values, first and second θ-derivatives) for y0, h y0',
+// h² y0'', y1, h y1', h² y1''.
+void hermite5(double t, double H[6], double dH[6], double ddH[6]) {
+  const double t2 = t * t, t3 = t2 * t, t4 = t3 * t, t5 = t4 * t;
+  H[0] = 1 - 10 * t3 + 15 * t4 - 6 * t5;
+  H[1] = t - 6 * t3 + 8 * t4 - 3 * t5;
+  H[2] = 0.5 * t2 - 1.5 * t3 + 1.5 * t4 - 0.5 * t5;
+  H[3] = 10 * t3 - 15 * t4 + 6 * t5;
+  H[4] = -4 * t3 + 7 * t4 - 3 * t5;
+  H[5] = 0.5 * t3 - t4 + 0.5 * t5;
+  dH[0] = -30 * t2 + 60 * t3 - 30 * t4;
+  dH[1] = 1 - 18 * t2 + 32 * t3 - 15 * t4;
+  dH[2] = t - 4.5 * t2 + 6 * t3 - 2.5 * t4;
+  dH[3] = 30 * t2 - 60 * t3 + 30 * t4;
+  dH[4] = -12 * t2 + 28 * t3 - 15 * t4;
+  dH[5] = 1.5 * t2 - 4 * t3 + 2.5 * t4;
+  ddH[0] = -60 * t + 180 * t2 - 120 * t3;
+  ddH[1] = -36 * t + 96 * t2 - 60 * t3;
+  ddH[2] = 1 - 9 * t + 18 * t2 - 10 * t3;
+  ddH[3] = 60 * t - 180 * t2 + 120 * t3;
+  ddH[4] = -24 * t + 84 * t2 - 60 * t3;
+  ddH[5] = 3 * t - 12 * t2 + 10 * t3;
+}
+
+// Cubic Hermite of an integral E with rate P.
+double hermite3(double t, double h, double E0, double P0, double E1, double P1) {
+  const double t2 = t * t, t3 = t2 * t;
+  return (2 * t3 - 3 * t2 + 1) * E0 + (t3 - 2 * t2 + t) * h * P0 + (-2 * t3 + 3 * t2) * E1 + (t3 - t2) * h * P1;
+}
+
+// Newton iteration and step-size control parameters.
+constexpr int kMaxNewton = 7;
+// Newton tolerance on the stage increment, in units of the error tolerance and in the max norm: a
+// weighted RMS over thousands of coordinates would hide an error confined to a few (a free joint,
+// the first rfes' torsion) that the next steps amplify. 0.02 costs ~6 % more iterations than 0.05
+// and halves the force-input error of the paper's case (bench/work_precision.py).
+constexpr double kNewtonTol = 0.02;
+constexpr double kSafety = 0.9, kMinFactor = 0.2, kMaxFactor = 5.0;
+
+}  // namespace
+
+void check_esdirk_table(const std::string& name) { load_tableau(name); }
+
+RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, const SampleSink& sink) {
+  const Tableau T = load_tableau(o.esdirk_table);
+  const int u = eq.unknowns(), s = T.s;
+  RunOutcome out;
+  IntegratorStats& st = out.stats;
+
+  VecX q, v;
+  eq.initial_state(q, v, o.initial == InitialState::Static);
+  VecX a = eq.accelerations(0.0, q.data(), v.data());
+  VecX r(u);
+  Power P = eq.residual(0.0, q.data(), v.data(), a.data(), r.data());
+  ++st.residual_evals;
+  double Wd = 0.0, Wi = 0.0;  // dissipated energy, input work
+  sink(eq.sample(0.0, q.data(), v.data(), a.data(), 0.0, 0.0));
+
+  std::vector<VecX> alpha(s, VecX::Zero(u));
+  std::vector<Power> Ps(s);
+  // 7 + s vectors of the unknowns' size (memory per rfe matters at 10⁴ rfes): after the stages Q, V
+  // hold the new solution and Qk, Vk the error estimate.
+  VecX w(2 * u), Qk(u), Vk(u), Q(u), V(u);
+  VecX &q1 = Q, &v1 = V, &eqv = Qk, &evv = Vk;
+  auto weights = [&](const VecX& qa, const VecX& va, const VecX* qb, const VecX* vb) {
+    for (int i = 0; i < u; ++i) {
+      const double yq = qb ? std::max(std::abs(qa[i]), std::abs((*qb)[i])) : std::abs(qa[i]);
+      const double yv = vb ? std::max(std::abs(va[i]), std::abs((*vb)[i])) : std::abs(va[i]);
+      w[i] = 1.0 / (o.rtol * yq + o.atol);
+      w[u + i] = 1.0 / (o.rtol * yv + o.atol_velocity);
+    }
+  };
+
+  // Initial step (Hairer & Wanner I, II.4): 1 % of the time for y to change by its own size.
+  weights(q, v, nullptr, nullptr);
+  double h = 0.0;
+  {
+    const double d0 = wrms(q, v, w), d1 = wrms(v, a, w);
+    h = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
+    h = std::min({h, o.output_dt, o.t_end});
+    if (o.max_step > 0) h = std::min(h, o.max_step);
+    h = std::max(h, 1e-10 * o.t_end);
+    if (o.fixed_step > 0) h = o.fixed_step;
+  }
+
+  // Fixed steps cannot be cut: give the Newton iteration room to reach the (tight) tolerance.
+  const int max_newton = o.fixed_step > 0 ? 60 : kMaxNewton;
+  double t = 0.0, err_prev = 1.0, eta = 1.0;
+  bool last_rejected = false;
+  const std::vector<double> breaks = eq.breakpoints(o.t_end);
+  size_t next_break = 0;
+  const long n_out = std::lround(std::ceil(o.t_end / o.output_dt - 1e-9));
+  long k_out = 1, steps_this_output = 0;
+  auto t_output = [&](long k) { return std::min(o.t_end, k * o.output_dt); };
+  auto fail = [&](const std::string& why) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, " at t = %.6g s (step %.3g s)", t, h);
+    out.status = "failed: " + why + buf + "; try looser tolerances, a smaller max_step, or check the inputs";
+    out.t_reached = t;
+    return out;
+  };
+
+  eq.govern_by_steps();
+  try {
+    while (k_out <= n_out) {
+      const auto step_start = std::chrono::steady_clock::now();
+      const long residuals_before = st.residual_evals;
+      // Every attempt (accepted or not) is timed for the thread governor.
+      struct StepTimer {
+        EquationsOfMotion& eq;
+        std::chrono::steady_clock::time_point start;
+        const long& now;
+        long before;
+        ~StepTimer() {
+          eq.report_step(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), now - before);
+        }
+      } timer{eq, step_start, st.residual_evals, residuals_before};
+      if (eq.stop_requested()) {
+        out.status = "interrupted (signal " + std::to_string(eq.stop_signal()) + ")";
+        return out;
+      }
+      if (steps_this_output > o.max_steps)
+        return fail("more than " + std::to_string(o.max_steps) + " steps in one output interval");
+      if (h < 1e-14 * std::max(1.0, t)) return fail("step size underflow");
+      // Land exactly on the next breakpoint of the inputs and on t_end; stretch a step that would
+      // leave a sliver.
+      while (next_break < breaks.size() && breaks[next_break] <= t * (1 + 1e-14)) ++next_break;
+      const double t_stop = next_break < breaks.size() ? breaks[next_break] : o.t_end;
+      if (t + 1.05 * h >= t_stop) h = t_stop - t;
+      const double hg = h * T.gamma;
+      weights(q, v, nullptr, nullptr);
+
+      // The Newton matrix S(hγ) = M + hγ C + (hγ)² K at the step's start, every step: the base
+      // angles turn the border of M and the sde forces turn the geometric part of K fast enough
+      // that older matrices cost Newton failures (and accuracy) under force input.
+      ++st.factorizations;
+      bool converged = eq.setup_newton(t, q.data(), v.data(), hg);
+
+      // Stages: α_0 = a_n (first same as last), then one Newton iteration per stage.
+      alpha[0] = a;
+      Ps[0] = P;
+      for (int i = 1; i < s && converged; ++i) {
+        const double ti = t + T.c[i] * h;
+        Vk = v;
+        Qk = q + (T.c[i] * h) * v;
+        for (int j = 0; j < i; ++j) {
+          Vk += (h * T.A(i, j)) * alpha[j];
+          Qk += (h * h * T.AA(i, j)) * alpha[j];
+        }
+        alpha[i] = alpha[i - 1];  // predictor (extrapolations measured no better)
+        double dn_prev = 0.0;
+        eta = std::pow(std::max(eta, 1e-16), 0.8);
+        converged = false;
+        for (int it = 0; it < max_newton; ++it) {
+          V = Vk + hg * alpha[i];
+          Q = Qk + (hg * hg) * alpha[i];
+          Ps[i] = eq.residual(ti, Q.data(), V.data(), alpha[i].data(), r.data());
+          ++st.residual_evals;
+          ++st.newton_iters;
+          if (!r.allFinite()) break;
+          eq.newton().solve(r);
+          r = -r;  // δα
+          alpha[i] += r;
+          const double dn = wmax_increment(r, hg, w);
+          if (it > 0) {  // contraction rate; give up if it cannot make it within the iterations left
+            const double theta = dn / dn_prev;
+            if (theta >= 0.99) break;
+            eta = theta / (1.0 - theta);
+            if (std::pow(theta, max_newton - 1 - it) / (1.0 - theta) * dn > kNewtonTol) break;
+          }
+          if (eta * dn <= kNewtonTol || dn < 1e-12) {
+            converged = true;
+            // The power was evaluated before this last update: carry it to the converged stage.
+            const Power dP = eq.power_change(ti, V.data(), r, hg);
+            Ps[i].input += dP.input;
+            Ps[i].dissipation += dP.dissipation;
+            break;
+          }
+          dn_prev = dn;
+        }
+      }
+      if (!converged) {  // with a fresh matrix: cut the step
+        ++st.newton_fails;
+        if (o.fixed_step > 0) return fail("Newton iteration failed with the fixed step");
+        h *= 0.25;
+        eta = 1.0;
+        last_rejected = true;
+        continue;
+      }
+
+      // Solution (stiffly accurate: the last stage) and error estimate.
+      Q = Qk + (hg * hg) * alpha[s - 1];  // q1
+      V = Vk + hg * alpha[s - 1];         // v1
+      eqv.setZero();
+      evv.setZero();
+      for (int j = 0; j < s; ++j) {
+        eqv += (h * h * T.eq[j]) * alpha[j];
+        evv += (h * T.ev[j]) * alpha[j];
+      }
+      weights(q, v, &q1, &v1);
+      const double err = std::max(wrms(eqv, evv, w), 1e-10);
+      const double expo = 1.0 / (T.embedded_order + 1);
+      if (err > 1.0 && o.fixed_step <= 0) {
+        ++st.error_test_fails;
+        h *= std::max(kMinFactor, kSafety * std::pow(err, -expo));
+        last_rejected = true;
+        continue;
+      }
+
+      // Accepted: outputs inside (t, t + h], then advance.
+      const double t1 = t + h;
+      const VecX& a1 = alpha[s - 1];
+      double Wd1 = Wd, Wi1 = Wi;
+      for (int j = 0; j < s; ++j) {
+        Wd1 += h * T.b[j] * Ps[j].dissipation;
+        Wi1 += h * T.b[j] * Ps[j].input;
+      }
+      const Power& P1 = Ps[s - 1];
+      ++st.steps;
+      ++steps_this_output;
+      st.last_step = h;
+      while (k_out <= n_out && t_output(k_out) <= t1 + 1e-12 * std::max(1.0, t1)) {
+        const double to = t_output(k_out);
+        OutputSample smp;
+        if (std::abs(to - t1) <= 1e-12 * std::max(1.0, t1)) {
+          smp = eq.sample(t1, q1.data(), v1.data(), a1.data(), Wd1, Wi1);
+        } else {
+          // The integrator's continuous solution: quintic Hermite of q from (q, v, a) at both
+          // ends, its derivatives for v and a (the accelerations of the solution, smooth in the
+          // stiff modes the steps damp; the torques of prescribed joints follow from them).
+          const double th = (to - t) / h;
+          double H[6], dH[6], ddH[6];
+          hermite5(th, H, dH, ddH);
+          const VecX qo = H[0] * q + (H[1] * h) * v + (H[2] * h * h) * a + H[3] * q1 + (H[4] * h) * v1 + (H[5] * h * h) * a1;
+          const VecX vo = (dH[0] / h) * q + dH[1] * v + (dH[2] * h) * a + (dH[3] / h) * q1 + dH[4] * v1 + (dH[5] * h) * a1;
+          const VecX ao = (ddH[0] / (h * h)) * q + (ddH[1] / h) * v + ddH[2] * a + (ddH[3] / (h * h)) * q1 +
+                          (ddH[4] / h) * v1 + ddH[5] * a1;
+          smp = eq.sample(to, qo.data(), vo.data(), ao.data(), hermite3(th, h, Wd, P.dissipation, Wd1, P1.dissipation),
+                          hermite3(th, h, Wi, P.input, Wi1, P1.input));
+        }
+        smp.steps = st.steps;
+        smp.last_step = h;
+        sink(smp);
+        out.t_reached = to;
+        ++k_out;
+        steps_this_output = 0;
+      }
+      t = t1;
+      q = q1;
+      v = v1;
+      a = a1;
+      P = P1;
+      Wd = Wd1;
+      Wi = Wi1;
+
+      // Next step: PI controller (Gustafsson), no growth right after a rejection.
+      double fac = kSafety * std::pow(err, -0.7 * expo) * std::pow(err_prev, 0.4 * expo);
+      fac = std::clamp(fac, kMinFactor, last_rejected ? 1.0 : kMaxFactor);
+      err_prev = err;
+      last_rejected = false;
+      h = o.fixed_step > 0 ? o.fixed_step : h * fac;
+      if (o.max_step > 0) h = std::min(h, o.max_step);
+    }
+  } catch (const std::exception& e) {
+    return fail(e.what());
+  }
+  out.completed = true;
+  out.status = "completed";
+  out.t_reached = o.t_end;
+  return out;
+}
+
+}  // namespace rfem

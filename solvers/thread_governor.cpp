@@ -1,0 +1,62 @@
+#include "solvers/thread_governor.hpp"
+
+#include <algorithm>
+
+namespace rfem {
+
+namespace {
+constexpr size_t kSamples = 12;      // units of work compared per team
+constexpr double kProbeFirst = 0.5, kProbeMax = 8.0;  // s of work on the chosen team between probes
+constexpr double kMargin = 0.9;      // a challenger must be 10 % faster to take over
+
+// The mean, not the median: when another process shares a core, a team's steps are now fast, now
+// stalled for a time slice; throughput is what counts.
+double mean(const std::vector<double>& v) {
+  double s = 0.0;
+  for (double x : v) s += x;
+  return s / static_cast<double>(v.size());
+}
+}  // namespace
+
+ThreadGovernor::ThreadGovernor(int max_threads, bool fixed)
+    : max_(std::max(1, max_threads)), current_(max_), best_(max_), adaptive_(!fixed && max_ > 1), probe_every_(kProbeFirst) {
+  if (adaptive_) probing_ = kSamples + 1;  // time the full team first, then one thread
+}
+
+void ThreadGovernor::record(double seconds) {
+  const int slot = current_ > 1 ? 1 : 0;
+  ++count_[slot];
+  if (!adaptive_) return;
+  const bool probe = probing_ > 0;
+  // The first evaluation after a switch is not timed: caches and sleeping threads are cold.
+  if (!probe || probing_ <= static_cast<int>(kSamples)) {
+    auto& s = sample_[slot];
+    s.push_back(seconds);
+    if (s.size() > kSamples) s.erase(s.begin());
+  }
+  if (!probe) {
+    since_probe_ += seconds;
+    if (since_probe_ > probe_every_) {  // challenge the chosen team
+      current_ = current_ > 1 ? 1 : max_;
+      probing_ = kSamples + 1;
+    }
+    return;
+  }
+  if (--probing_ > 0) return;
+  const int other = slot ^ 1;
+  if (sample_[other].size() < kSamples) {  // first round: now time the other team
+    current_ = other ? max_ : 1;
+    probing_ = kSamples + 1;
+    return;
+  }
+  const double mine = mean(sample_[slot]), theirs = mean(sample_[other]);
+  const bool incumbent = (best_ > 1) == (slot == 1);
+  const bool keep_mine = incumbent ? mine <= theirs / kMargin : mine < kMargin * theirs;
+  const int before = best_;
+  best_ = keep_mine ? current_ : (other ? max_ : 1);
+  current_ = best_;
+  since_probe_ = 0.0;
+  probe_every_ = best_ == before ? std::min(kProbeMax, 2 * probe_every_) : kProbeFirst;
+}
+
+}  // namespace rfem

@@ -1,0 +1,93 @@
+// The block Cholesky of the bordered chain (solvers/chain_solver.hpp) against a dense solve, for
+// every shape the split can take (no rfes, one, two, odd and even chains, with and without a
+// border), and bit-identical results with the two sweeps on one and on two threads.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <random>
+
+#include "assembly/assemble.hpp"
+#include "solvers/chain_solver.hpp"
+#include "solvers/cholmod_solver.hpp"
+#include "tests/test_models.hpp"
+
+using namespace rfem;
+
+namespace {
+
+// A random symmetric positive definite matrix on the pattern: diagonally dominant values.
+std::vector<double> random_spd(const BorderedPattern& p, unsigned seed) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<double> v(p.nnz());
+  for (auto& x : v) x = u(gen);
+  for (int c = 0; c < p.size(); ++c) v[p.slot(c, c)] = 40.0 + 10.0 * u(gen);
+  return v;
+}
+
+}  // namespace
+
+TEST(ChainSolver, EqualsDenseSolveForEveryShape) {
+  for (int nb : {0, 1, 3})
+    for (int n : {0, 1, 2, 3, 4, 7, 40}) {
+      if (n == 0 && nb == 0) continue;
+      const BorderedPattern p(n, nb);
+      auto v = random_spd(p, 17 + 3 * n + nb);
+      const MatX A = to_dense(p, v);
+      ChainSolver cs(p);
+      ASSERT_TRUE(cs.factorize(v)) << "n = " << n << ", nb = " << nb;
+      VecX b = VecX::LinSpaced(p.size(), -1.0, 2.0), x = b;
+      cs.solve(x);
+      const VecX ref = A.ldlt().solve(b);
+      EXPECT_LT((x - ref).norm(), 1e-13 * ref.norm()) << "n = " << n << ", nb = " << nb;
+    }
+}
+
+TEST(ChainSolver, MatchesCholmodOnANewtonMatrix) {
+  // S = M + hC + h²K of a real link with two free joints at a deformed, moving state: the
+  // conditioning the time integration sees (stiff axial springs against light rfes).
+  const Model m = test::spatial_arm(30, 2e-3);
+  VecX q, v, a;
+  test::random_state(m, 7, q, v, a);
+  q.head(6 * m.n()) *= 1e-3;  // a physical deformation (the random 5 cm would buckle the axial springs)
+  const BorderedPattern p(m.n(), 2);
+  for (double h : {1e-4, 1e-2}) {
+    MatrixTerms t;
+    t.mass = 1.0;
+    t.damping = h;
+    t.stiffness = h * h;
+    std::vector<double> values;
+    assemble_matrix(m, p, {6 * m.n(), 6 * m.n() + 1}, q, v, t, values);
+    ChainSolver chain(p);
+    CholmodSolver cholmod(p);
+    ASSERT_TRUE(cholmod.factorize(values));
+    ASSERT_TRUE(chain.factorize(values));  // in place: after CHOLMOD has copied them
+    VecX x1 = VecX::LinSpaced(p.size(), 1.0, -1.0), x2 = x1;
+    chain.solve(x1);
+    cholmod.solve(x2);
+    EXPECT_LT((x1 - x2).norm(), 1e-10 * x2.norm()) << "h = " << h;
+  }
+}
+
+TEST(ChainSolver, RefusesAnIndefiniteMatrix) {
+  const BorderedPattern p(5, 2);
+  auto v = random_spd(p, 3);
+  v[p.slot(6 * 4 + 2, 6 * 4 + 2)] = -50.0;  // a negative pivot in the bottom sweep
+  ChainSolver cs(p);
+  EXPECT_FALSE(cs.factorize(v));
+}
+
+TEST(ChainSolver, OneAndTwoThreadsAreBitIdentical) {
+  const BorderedPattern p(101, 3);
+  const auto v0 = random_spd(p, 5);
+  VecX x[2];
+  std::vector<double> v[2] = {v0, v0};
+  for (int t : {1, 2}) {
+    ChainSolver cs(p);
+    cs.set_threads(t);
+    ASSERT_TRUE(cs.factorize(v[t - 1]));
+    x[t - 1] = VecX::LinSpaced(p.size(), 1.0, -3.0);
+    cs.solve(x[t - 1]);
+  }
+  EXPECT_EQ((x[0] - x[1]).cwiseAbs().maxCoeff(), 0.0);
+}
