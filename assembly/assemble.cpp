@@ -128,7 +128,6 @@ void generalised_forces(const Model& model, const VecX& q, const VecX& v, const 
     flex += ws.moments[c];
     Pd += ws.power[c];
   }
-  if (dissipation) *dissipation = Pd;
   const auto S = suffix_moments(model, bk, flex);
   for (int j = 0; j < m; ++j) {
     const Mat4& X = bk.Xi[j];
@@ -136,7 +135,16 @@ void generalised_forces(const Model& model, const VecX& q, const VecX& v, const 
     if (terms.inertia)  // rigid links through Y; the rfes through their wrench and joint j's unit twist
       eps = trace_prod(X, S[j].Y) + Vec3(X(2, 1), X(0, 2), X(1, 0)).dot(flex.n) + X.topRightCorner<3, 1>().dot(flex.f);
     F[6 * n + j] = eps + g * (X * S[j].s)[2];
+    const JointDrive& dr = model.joints[j].drive;
+    if (!dr.active()) continue;
+    const double vj = v[6 * n + j];
+    if (terms.inertia) F[6 * n + j] += dr.inertia * a[6 * n + j];
+    if (terms.sde) {
+      F[6 * n + j] += dr.dissipative_force(vj);
+      Pd += dr.power(vj);
+    }
   }
+  if (dissipation) *dissipation = Pd;
 }
 
 namespace {
@@ -239,11 +247,13 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
     for (int l = 0; l < m; ++l) {
       if (col[l] < 0) continue;  // columns are unknowns only
       const int hi = std::max(j, l);
-      const double mass = t.mass * trace_prod(bk.Xi[j] * S[hi].G, bk.Xi[l].transpose());
+      double mass = t.mass * trace_prod(bk.Xi[j] * S[hi].G, bk.Xi[l].transpose());
+      if (j == l) mass += t.mass * model.joints[j].drive.inertia;
       if (base_rows) (*base_rows)(j, base_col[l]) = mass;
       if (col[j] < 0 || l < j) continue;
       double val = mass;
       if (g != 0.0) val += t.stiffness * g * (bk.Xi[j] * bk.Xi[l] * S[hi].s)[2];
+      if (j == l && t.damping != 0.0) val += t.damping * model.joints[j].drive.damping_derivative(v[6 * n + j]);
       values[pattern.base() + static_cast<long>(std::min(col[j], col[l])) * nb + std::max(col[j], col[l])] += val;
     }
 }
@@ -266,6 +276,9 @@ Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* w
     const Mat4& H = model.joints[i].H;
     E.kinetic += 0.5 * trace_prod(bk.Wd[i] * H, bk.Wd[i].transpose());
     E.gravity += model.gravity * (bk.W[i] * H.col(3))[2];
+    const double vi = v[6 * n + i];
+    E.kinetic += model.joints[i].drive.kinetic_energy(vi);
+    E.dissipation_rate += model.joints[i].drive.power(vi);
   }
   const int nchunks = ws.chunks(n);
   std::vector<Eigen::Vector4d> part(nchunks, Eigen::Vector4d::Zero());  // T, V_g, V_e, P_d per chunk
@@ -287,7 +300,7 @@ Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* w
   E.kinetic += sum[0];
   E.gravity += sum[1];
   E.elastic = sum[2];
-  E.dissipation_rate = sum[3];
+  E.dissipation_rate += sum[3];
   return E;
 }
 

@@ -12,22 +12,24 @@ namespace rfem {
 
 /// Which generalised forces to include (inputs τ are never included: the caller adds them).
 struct ForceTerms {
-  bool inertia = true, gravity = true;
-  bool sde = true;  ///< elastic and damping forces of the sdes
+  bool inertia = true, gravity = true;  ///< inertia includes the joint drives' inertia J q̈
+  bool sde = true;  ///< elastic and damping forces of the sdes, and the joint drives' damping and friction
   /// Velocity-product (Coriolis, centrifugal) terms h of the inertial force. Off only to show what
   /// a model without them gets wrong (tests): then ε = M(q) a.
   bool velocity_products = true;
 };
 
 /// F = ε(q, v, a) + ∂V_g/∂q + ∂V_e/∂q + sde damping for all 6n + m coordinates (flexible first).
-/// If `dissipation` is given, the power dissipated in the sdes [W] goes there (same pass).
+/// plus every joint drive's τ_drive (core/joint_drive.hpp). If `dissipation` is given, the power
+/// dissipated in the sdes and the drives [W] goes there (same pass).
 /// `ws` (may be null: a temporary one) holds the thread policy and scratch.
 void generalised_forces(const Model& model, const VecX& q, const VecX& v, const VecX& a,
                         const ForceTerms& terms, VecX& F, double* dissipation = nullptr, Workspace* ws = nullptr);
 
 /// Coefficients of the matrix S = mass·M + damping·C + stiffness·K assembled into the pattern.
 /// K holds the sde stiffness (with its geometric term), and on request the gravity stiffness and
-/// the centrifugal (inertial) stiffness of the rfe blocks at the base velocity in v.
+/// the centrifugal (inertial) stiffness of the rfe blocks at the base velocity in v. M includes
+/// the drives' inertia J, C their ∂τ_drive/∂q̇ at v (free joints' diagonal).
 struct MatrixTerms {
   double mass = 0.0, damping = 0.0, stiffness = 0.0;
   bool gravity = false;
@@ -54,7 +56,7 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
 
 struct Energies {
   double kinetic = 0.0, elastic = 0.0, gravity = 0.0;
-  double dissipation_rate = 0.0;  ///< power dissipated in the sdes [W]
+  double dissipation_rate = 0.0;  ///< power dissipated in the sdes and the joint drives [W]
 };
 Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* ws = nullptr);
 

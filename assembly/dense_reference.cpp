@@ -82,6 +82,7 @@ MatX dense_mass_matrix(const Model& model, const VecX& q) {
   for (const Body& b : bodies(model, q, false))
     for (int i = 0; i < N; ++i)
       for (int j = 0; j < N; ++j) M(i, j) += (b.dW[i] * b.H * b.dW[j].transpose()).trace();
+  for (int j = 0; j < model.m(); ++j) M(model.base_index(j), model.base_index(j)) += model.joints[j].drive.inertia;
   return M;
 }
 
@@ -107,7 +108,7 @@ MatX dense_stiffness(const Model& model, const VecX& q, bool gravity) {
   return K;
 }
 
-MatX dense_damping(const Model& model, const VecX& q) {
+MatX dense_damping(const Model& model, const VecX& q, const VecX& v) {
   const int n = model.n(), N = model.dof();
   MatX C = MatX::Zero(N, N);
   for (int e = 0; e < n; ++e) {
@@ -122,6 +123,8 @@ MatX dense_damping(const Model& model, const VecX& q) {
         if (ra >= 0 && rb >= 0) C(ra, rb) += S(a, b);
       }
   }
+  for (int j = 0; j < model.m(); ++j)
+    C(model.base_index(j), model.base_index(j)) += model.joints[j].drive.damping_derivative(v[model.base_index(j)]);
   return C;
 }
 

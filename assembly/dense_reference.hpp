@@ -7,10 +7,12 @@
 
 namespace rfem {
 
+/// Includes the joint drives' inertia on the base diagonal.
 MatX dense_mass_matrix(const Model& model, const VecX& q);
 /// ∂²(V_e + V_g)/∂q² (gravity only if `gravity`).
 MatX dense_stiffness(const Model& model, const VecX& q, bool gravity);
-/// ∂²R/∂q̇² of the sde damping (Rayleigh dissipation function).
-MatX dense_damping(const Model& model, const VecX& q);
+/// ∂²R/∂q̇² of the sde damping (Rayleigh dissipation function), plus the joint drives'
+/// ∂τ_drive/∂q̇ at the velocities v (base diagonal).
+MatX dense_damping(const Model& model, const VecX& q, const VecX& v);
 
 }  // namespace rfem

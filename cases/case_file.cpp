@@ -329,6 +329,16 @@ Mat4 read_body(const Reader& r, const toml::table& t, const std::string& path,
   return pseudo_inertia(mass, com, I);
 }
 
+JointDrive read_drive(const Reader& r, const toml::table& t, const std::string& path) {
+  r.check_keys(t, path, {"inertia", "damping", "friction", "friction_velocity"});
+  JointDrive d;
+  d.inertia = r.non_negative(t, path, "inertia", d.inertia);
+  d.damping = r.non_negative(t, path, "damping", d.damping);
+  d.friction = r.non_negative(t, path, "friction", d.friction);
+  d.friction_velocity = r.positive(t, path, "friction_velocity", d.friction_velocity);
+  return d;
+}
+
 InputSpec read_input(const Reader& r, const toml::table& t, const std::string& path, const std::string& case_dir) {
   InputSpec in;
   std::ostringstream where;  // (ostringstream: GCC 12 warns falsely on ":" + std::to_string)
@@ -495,7 +505,7 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
     for (size_t i = 0; i < arr->size(); ++i) {
       const toml::table& jt = *arr->get(i)->as_table();
       const std::string p = "joints." + std::to_string(i);
-      r.check_keys(jt, p, {"name", "type", "alpha", "a", "theta", "d", "value", "rate", "body", "input"});
+      r.check_keys(jt, p, {"name", "type", "alpha", "a", "theta", "d", "value", "rate", "body", "drive", "input"});
       Joint j;
       j.name = r.string(jt, p, "name", "joint" + std::to_string(i + 1));
       const std::string type = r.string(jt, p, "type", std::string("revolute"));
@@ -512,6 +522,10 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
       if (const toml::node* bn = jt.get("body")) {
         if (!bn->is_table()) r.fail(bn, p + ".body", "must be a table");
         j.H = read_body(r, *bn->as_table(), p + ".body", mats, secs);
+      }
+      if (const toml::node* dn = jt.get("drive")) {
+        if (!dn->is_table()) r.fail(dn, p + ".drive", "must be a table {inertia = …, damping = …, friction = …}");
+        j.drive = read_drive(r, *dn->as_table(), p + ".drive");
       }
       InputSpec in;
       {

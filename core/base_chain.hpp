@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "core/joint_drive.hpp"
 #include "core/types.hpp"
 
 namespace rfem {
@@ -19,6 +20,7 @@ struct Joint {
   double theta = 0.0;  ///< θ_i0 [rad]
   double d = 0.0;      ///< d_i0 [m]
   Mat4 H = Mat4::Zero();  ///< pseudo-inertia of base link i in its own frame
+  JointDrive drive;       ///< rotor/gear inertia, damping, friction of the joint (none by default)
   double mass() const { return H(3, 3); }
 };
 

@@ -21,7 +21,9 @@ EquationsOfMotion::EquationsOfMotion(const Model& model, const std::vector<Joint
       terms_(terms),
       governor_(model.n() >= parallel.min_rfes ? (parallel.threads > 0 ? parallel.threads : omp_get_max_threads()) : 1,
                 parallel.threads > 0),
-      damped_(model.link.damping_beta > 0) {
+      damped_(model.link.damping_beta > 0 ||
+              std::any_of(model.joints.begin(), model.joints.end(),
+                          [](const Joint& j) { return j.drive.damping > 0 || j.drive.friction > 0; })) {
   ws_.parallel = parallel;
   ws_.parallel.threads = governor_.threads();
   if (static_cast<int>(inputs.size()) != model.m()) throw std::invalid_argument("one input per joint is required");
@@ -90,11 +92,13 @@ Power EquationsOfMotion::power_change(double t, const double* vu, const VecX& da
     if (inputs_[j].prescribed()) d.input += inputs_[j].motion->at(t).qd * rows.row(j).dot(da);
     else d.input += inputs_[j].torque->at(t) * hg * da[base_col_[j]];
   }
-  if (damped_) {
+  if (model_.link.damping_beta > 0) {  // the Newton system keeps the sdes' C only then
     VecX Cda;
     newton_->damping_times(da, Cda);
     d.dissipation = 2.0 * hg * Eigen::Map<const VecX>(vu, unknowns()).dot(Cda);
   }
+  for (int j = 0; j < model_.m(); ++j)  // the drives' power, not a quadratic form when they have friction
+    if (base_col_[j] >= 0) d.dissipation += model_.joints[j].drive.power_derivative(vu[base_col_[j]]) * hg * da[base_col_[j]];
   return d;
 }
 

@@ -96,7 +96,7 @@ class EquationsOfMotion {
   std::unique_ptr<NewtonSystem> newton_;
   std::vector<double> mass_values_;
   VecX q_, v_, a_, F_;
-  bool damped_;
+  bool damped_;  ///< something dissipates: sde damping or a joint drive's damping or friction
 };
 
 }  // namespace rfem

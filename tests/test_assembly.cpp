@@ -39,11 +39,13 @@ std::vector<double> newton_values(const Model& m, const BorderedPattern& p, cons
 }  // namespace
 
 TEST(Assembly, SparseEqualsDenseReferenceWithOneAndTwoThreads) {
-  const Model m = test::spatial_arm(7, 0.002);
+  Model m = test::spatial_arm(7, 0.002);
+  m.joints[0].drive = {0.4, 0.8, 0.3, 0.5};  // rotor inertia, damping and friction on two joints
+  m.joints[2].drive = {0.1, 0.0, 0.2, 0.05};
   VecX q, v, a;
   test::random_state(m, 11, q, v, a);
   const BorderedPattern p(m.n(), m.m());
-  const MatX ref = 400.0 * dense_mass_matrix(m, q) + 20.0 * dense_damping(m, q) + dense_stiffness(m, q, true);
+  const MatX ref = 400.0 * dense_mass_matrix(m, q) + 20.0 * dense_damping(m, q, v) + dense_stiffness(m, q, true);
   for (int threads : {1, 2}) {
     const MatX S = to_dense(p, newton_values(m, p, q, v, threads));
     EXPECT_LT((S - ref).norm() / ref.norm(), 1e-12) << threads << " thread(s)";

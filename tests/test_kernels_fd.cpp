@@ -153,6 +153,50 @@ TEST(KernelsFD, DampingMatrixIsJacobianOfDampingForces) {
   EXPECT_NEAR(energies(m, q, v).dissipation_rate, v.dot(fd(v) - f0), 1e-9 * std::abs(v.dot(fd(v) - f0)));
 }
 
+TEST(KernelsFD, JointDrivesAreConsistent) {
+  // Rotor inertia, viscous damping and tanh-smoothed Coulomb friction on every joint (issue 10 §6):
+  // M is still the Hessian of the kinetic energy (with ½ J q̇²), C the Jacobian of the dissipative
+  // forces (friction's slope F_c/v_s sech² included), the dissipated power q̇ · f_d, and the drive's
+  // generalised force J q̈ + c q̇ + F_c tanh(q̇/v_s) lands in the joint's row only. v_s = 0.3 rad/s
+  // keeps tanh smooth on the FD step (h/v_s ~ 3e-5), so the 1e-6 bound above still holds.
+  Model m = test::spatial_arm(3, 0.01);
+  for (auto& j : m.joints) j.drive = {0.25, 0.6, 0.4, 0.3};
+  const Model bare = test::spatial_arm(3, 0.01);
+  VecX q, v, a;
+  test::random_state(m, 8, q, v, a);
+  const VecX zero = VecX::Zero(m.dof());
+  MatrixTerms tm;
+  tm.mass = 1.0;
+  const MatX Mfd = fd_jacobian([&](const VecX& x) { return fd_gradient([&](const VecX& y) { return energies(m, q, y).kinetic; }, x); }, v, 1e-4);
+  EXPECT_LT(rel(assembled(m, q, v, tm), Mfd), 1e-6);
+  EXPECT_LT(rel(dense_mass_matrix(m, q), Mfd), 1e-6);
+  MatrixTerms tc;
+  tc.damping = 1.0;
+  auto fd = [&](const VecX& x) {
+    VecX f;
+    generalised_forces(m, q, x, zero, only(false, false, true), f);
+    return f;
+  };
+  const MatX Cfd = fd_jacobian(fd, v);
+  EXPECT_LT(rel(assembled(m, q, v, tc), Cfd), 1e-6);
+  EXPECT_LT(rel(dense_damping(m, q, v), Cfd), 1e-6);
+  VecX f0;
+  generalised_forces(m, q, zero, zero, only(false, false, true), f0);
+  EXPECT_NEAR(energies(m, q, v).dissipation_rate, v.dot(fd(v) - f0), 1e-9 * std::abs(v.dot(fd(v) - f0)));
+  VecX F, Fb;
+  double P = 0.0, Pb = 0.0;
+  generalised_forces(m, q, v, a, ForceTerms{}, F, &P);
+  generalised_forces(bare, q, v, a, ForceTerms{}, Fb, &Pb);
+  VecX expect = Fb;
+  for (int j = 0; j < m.m(); ++j) {
+    const double vj = v[m.base_index(j)], aj = a[m.base_index(j)];
+    expect[m.base_index(j)] += 0.25 * aj + 0.6 * vj + 0.4 * std::tanh(vj / 0.3);
+    Pb += vj * (0.6 * vj + 0.4 * std::tanh(vj / 0.3));
+  }
+  EXPECT_LT((F - expect).norm(), 1e-12 * Fb.norm());
+  EXPECT_NEAR(P, Pb, 1e-12 * Pb);
+}
+
 TEST(KernelsFD, CentrifugalStiffnessIsJacobianOfInertialForce) {
   const Model m = test::spatial_arm(3);
   VecX q, v, a;

@@ -1,0 +1,17 @@
+#include "core/joint_drive.hpp"
+
+#include <cmath>
+
+namespace rfem {
+
+double JointDrive::dissipative_force(double v) const {
+  return damping * v + (friction != 0.0 ? friction * std::tanh(v / friction_velocity) : 0.0);
+}
+
+double JointDrive::damping_derivative(double v) const {
+  if (friction == 0.0) return damping;
+  const double c = std::cosh(v / friction_velocity);
+  return damping + friction / (friction_velocity * c * c);  // sech² → 0 far from v = 0, no overflow
+}
+
+}  // namespace rfem
