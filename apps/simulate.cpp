@@ -79,8 +79,22 @@ std::shared_ptr<TorqueLaw> torque_from_results(const InputSpec& in, int joint, d
 
 }  // namespace
 
+namespace {
+// A prescribed motion of one of the motion kinds, starting from the joint's value q0.
+std::shared_ptr<MotionLaw> motion_law(const InputSpec& in, double q0) {
+  if (in.kind == "deployment") return deployment_law(q0, in.alpha, in.T);
+  if (in.kind == "spinup") return spinup_law(q0, in.Omega, in.T);
+  if (in.kind == "constant_rate") return constant_rate_law(q0, in.rate);
+  std::vector<double> t, q;
+  read_csv_series(in.file, t, q);
+  return tabulated_motion(t, q);
+}
+}  // namespace
+
 std::vector<JointInput> joint_inputs(const Case& cs) {
   std::vector<JointInput> out(cs.joints.size());
+  std::vector<std::shared_ptr<MotionLaw>> reference(cs.joints.size());  // of PD joints
+  bool rigid_ff = false;
   for (size_t j = 0; j < cs.joints.size(); ++j) {
     const InputSpec& in = cs.inputs[j];
     const double q0 = cs.joint_values[static_cast<long>(j)], v0 = cs.joint_rates[static_cast<long>(j)];
@@ -88,20 +102,18 @@ std::vector<JointInput> joint_inputs(const Case& cs) {
     ji.q0 = q0;
     ji.v0 = v0;
     try {
-      if (in.kind == "deployment") ji.motion = deployment_law(q0, in.alpha, in.T);
-      else if (in.kind == "spinup") ji.motion = spinup_law(q0, in.Omega, in.T);
-      else if (in.kind == "constant_rate") ji.motion = constant_rate_law(q0, in.rate);
-      else if (in.kind == "table") {
-        std::vector<double> t, q;
-        read_csv_series(in.file, t, q);
-        ji.motion = tabulated_motion(t, q);
-      } else if (in.kind == "torque") ji.torque = constant_torque(in.value);
+      if (in.prescribed()) ji.motion = motion_law(in, q0);
+      else if (in.kind == "torque") ji.torque = constant_torque(in.value);
       else if (in.kind == "torque_table") {
         std::vector<double> t, tau;
         read_csv_series(in.file, t, tau);
         ji.torque = tabulated_torque(t, tau);
       } else if (in.kind == "torque_from_run") {
         ji.torque = torque_from_results(in, static_cast<int>(j), cs.has_simulation ? cs.sim.options.t_end : 0.0);
+      } else if (in.kind == "pd") {
+        reference[j] = motion_law(*in.reference, q0);
+        ji.torque = pd_law(reference[j], in.kp, in.kd, nullptr);
+        rigid_ff |= in.feedforward == "rigid";
       }
     } catch (const CaseError&) {
       throw;
@@ -111,6 +123,25 @@ std::vector<JointInput> joint_inputs(const Case& cs) {
     if (ji.motion) {  // a prescribed joint starts on its law
       ji.q0 = ji.motion->at(0.0).q;
       ji.v0 = ji.motion->at(0.0).qd;
+    }
+  }
+  if (rigid_ff) {
+    // Computed torque: the rigid manipulator's inverse dynamics along every joint's motion or
+    // reference, so every joint needs one.
+    std::vector<JointInput> laws(out.size());
+    for (size_t j = 0; j < out.size(); ++j) {
+      laws[j].motion = out[j].motion ? out[j].motion : reference[j];
+      if (!laws[j].motion)
+        throw CaseError(cs.inputs[j].where + ": feedforward = \"rigid\" needs a motion or a PD reference on every joint");
+    }
+    const auto rigid = std::make_shared<const Model>(rigidify(build_model(cs)));
+    const std::vector<JointInput> ff = rigid_torque_inputs(*rigid, laws);
+    for (size_t j = 0; j < out.size(); ++j) {
+      const InputSpec& in = cs.inputs[j];
+      if (in.kind != "pd" || in.feedforward != "rigid") continue;
+      const auto f = ff[j].torque;
+      auto keep = torque_function([rigid, f](double t) { return f->at(t); }, f->breakpoints());  // rigid lives on
+      out[j].torque = pd_law(reference[j], in.kp, in.kd, keep);
     }
   }
   return out;
@@ -172,7 +203,9 @@ RunSummary run_one(ResultsFile& file, const std::string& name, const Model& mode
   group.attribute("newton_fails", static_cast<long>(r.stats.newton_fails));
   group.attribute("error_test_fails", static_cast<long>(r.stats.error_test_fails));
   std::vector<std::string> kinds;
-  for (const auto& in : inputs) kinds.push_back(in.prescribed() ? "motion" : "torque");
+  for (const auto& in : inputs)
+    kinds.push_back(in.prescribed() ? "motion"
+                    : (in.torque->stiffness() != 0.0 || in.torque->damping() != 0.0) ? "feedback" : "torque");
   group.attribute("inputs", fmt::format("{}", fmt::join(kinds, ",")));
   group.status(r.status);
   group.close();

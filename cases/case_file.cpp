@@ -374,9 +374,22 @@ InputSpec read_input(const Reader& r, const toml::table& t, const std::string& p
     file_key();
     in.run = r.string(t, path, "run");
     in.joint = static_cast<int>(r.integer(t, path, "joint", 0, 1, 1000));
+  } else if (in.kind == "pd") {
+    r.check_keys(t, path, {"kind", "reference", "kp", "kd", "feedforward"});
+    const toml::node* rn = t.get("reference");
+    if (!rn || !rn->is_table())
+      r.fail(rn ? rn : &t, path + ".reference", "a PD input needs a reference motion {kind = \"deployment\", …}");
+    in.reference = std::make_shared<InputSpec>(read_input(r, *rn->as_table(), path + ".reference", case_dir));
+    if (!in.reference->prescribed())
+      r.fail(rn, path + ".reference.kind", "the reference must be a motion (deployment, spinup, constant_rate, table)");
+    in.kp = r.non_negative(t, path, "kp", 0.0);
+    in.kd = r.non_negative(t, path, "kd", 0.0);
+    in.feedforward = r.string(t, path, "feedforward", std::string("none"));
+    if (in.feedforward != "none" && in.feedforward != "rigid")
+      r.fail(t.get("feedforward"), path + ".feedforward", "must be \"none\" or \"rigid\" (got \"" + in.feedforward + "\")");
   } else {
     r.fail(t.get("kind"), path + ".kind",
-           "unknown input '" + in.kind + "' (deployment, spinup, constant_rate, table, torque, torque_table, torque_from_run)");
+           "unknown input '" + in.kind + "' (deployment, spinup, constant_rate, table, torque, torque_table, torque_from_run, pd)");
   }
   return in;
 }

@@ -1,4 +1,5 @@
 #pragma once
+#include <memory>
 // Case files: human-edited TOML describing materials, sections, the flexible link's segments and
 // discretisation, the base joints and their rigid links, gravity and loads. Every key is checked;
 // a bad file raises CaseError with a one-line "file:line: key: what is wrong" message.
@@ -20,12 +21,17 @@ class CaseError : public std::runtime_error {
 
 /// A joint's input in a time integration (`joints[].input`); the kinds are documented in README.md.
 struct InputSpec {
-  std::string kind = "torque";  ///< deployment | spinup | constant_rate | table | torque | torque_table | torque_from_run
+  std::string kind = "torque";  ///< deployment | spinup | constant_rate | table | torque | torque_table | torque_from_run | pd
   double alpha = 0, T = 0, Omega = 0, rate = 0, value = 0;
   std::string file;  ///< table or results file, resolved relative to the case file
   std::string run;   ///< group in a results file
   int joint = 0;     ///< joint (1-based) of the results file; 0: the same joint
   std::string where; ///< "file:line: joints.i.input" for later error messages
+  /// kind = "pd": τ = τ_ff + kp (q_ref − q) + kd (q̇_ref − q̇) on the reference motion (one of the
+  /// prescribed kinds, from the joint's value); feedforward "none" or "rigid" (computed torque).
+  std::shared_ptr<InputSpec> reference;
+  double kp = 0, kd = 0;
+  std::string feedforward = "none";
   bool prescribed() const { return kind == "deployment" || kind == "spinup" || kind == "constant_rate" || kind == "table"; }
 };
 

@@ -38,6 +38,15 @@ EquationsOfMotion::EquationsOfMotion(const Model& model, const std::vector<Joint
       ++nb;
     }
   newton_ = std::make_unique<NewtonSystem>(model, base_col_, nb, solver, &ws_, keep_stiffness);
+  std::vector<double> kp, kd;  // feedback laws stiffen and damp their joints (in column order)
+  bool feedback = false;
+  for (int j = 0; j < model.m(); ++j)
+    if (!inputs[j].prescribed()) {
+      kp.push_back(inputs[j].torque->stiffness());
+      kd.push_back(inputs[j].torque->damping());
+      feedback |= kp.back() != 0.0 || kd.back() != 0.0;
+    }
+  if (feedback) newton_->set_joint_feedback(std::move(kp), std::move(kd));
 }
 
 void EquationsOfMotion::expand(double t, const double* qu, const double* vu, const double* au) {
@@ -63,7 +72,8 @@ void EquationsOfMotion::expand(double t, const double* qu, const double* vu, con
 VecX EquationsOfMotion::torques(double t) const {
   VecX tau(model_.m());
   for (int j = 0; j < model_.m(); ++j)
-    tau[j] = inputs_[j].prescribed() ? F_[model_.base_index(j)] : inputs_[j].torque->at(t);
+    tau[j] = inputs_[j].prescribed() ? F_[model_.base_index(j)]
+                                     : inputs_[j].torque->at(t, q_[model_.base_index(j)], v_[model_.base_index(j)]);
   return tau;
 }
 
@@ -90,7 +100,11 @@ Power EquationsOfMotion::power_change(double t, const double* vu, const VecX& da
   const MatX& rows = newton_->base_rows();
   for (int j = 0; j < model_.m(); ++j) {
     if (inputs_[j].prescribed()) d.input += inputs_[j].motion->at(t).qd * rows.row(j).dot(da);
-    else d.input += inputs_[j].torque->at(t) * hg * da[base_col_[j]];
+    else {  // P = τ(t, q, v) v with δv = hγ δa, δq = (hγ)² δa
+      const TorqueLaw& law = *inputs_[j].torque;
+      const double vj = vu[base_col_[j]], dq = hg * hg * da[base_col_[j]], dv = hg * da[base_col_[j]];
+      d.input += law.at(t, q_[model_.base_index(j)], vj) * dv - (law.stiffness() * dq + law.damping() * dv) * vj;
+    }
   }
   if (model_.link.damping_beta > 0) {  // the Newton system keeps the sdes' C only then
     VecX Cda;

@@ -52,7 +52,7 @@ class EquationsOfMotion {
   /// r_u at (t, q_u, v_u, a_u); returns the power flows of that state.
   Power residual(double t, const double* qu, const double* vu, const double* au, double* r);
   /// First-order change of a state's power flows when its accelerations move by δa_u at fixed
-  /// Q_u = Q + hγ² δa, V_u = V + hγ δa (the last Newton update of an ESDIRK stage): required
+  /// Q_u = Q + (hγ)² δa, V_u = V + hγ δa (the last Newton update of an ESDIRK stage): required
   /// torques change by the mass rows M_bu δa, velocities by hγ δa, damping power by 2 Vᵀ C hγ δa.
   /// Uses the Newton system's last mass and damping.
   Power power_change(double t, const double* vu, const VecX& da, double hg);

@@ -140,7 +140,41 @@ class FunctionTorque : public TorqueLaw {
   std::vector<double> b_;
 };
 
+class PdTorque : public TorqueLaw {
+ public:
+  PdTorque(std::shared_ptr<MotionLaw> ref, double kp, double kd, std::shared_ptr<TorqueLaw> ff)
+      : ref_(std::move(ref)), ff_(std::move(ff)), kp_(kp), kd_(kd) {
+    if (!ref_) throw std::invalid_argument("a PD law needs a reference motion");
+    if (!(kp_ >= 0.0) || !(kd_ >= 0.0)) throw std::invalid_argument("PD gains must not be negative");
+  }
+  double at(double t) const override { return ff_ ? ff_->at(t) : 0.0; }
+  double at(double t, double q, double v) const override {
+    const MotionSample r = ref_->at(t);
+    return at(t) + kp_ * (r.q - q) + kd_ * (r.qd - v);
+  }
+  double stiffness() const override { return kp_; }
+  double damping() const override { return kd_; }
+  std::vector<double> breakpoints() const override {
+    std::vector<double> b = ref_->breakpoints();
+    if (ff_) {
+      const auto f = ff_->breakpoints();
+      b.insert(b.end(), f.begin(), f.end());
+    }
+    return b;
+  }
+
+ private:
+  std::shared_ptr<MotionLaw> ref_;
+  std::shared_ptr<TorqueLaw> ff_;
+  double kp_, kd_;
+};
+
 }  // namespace
+
+std::shared_ptr<TorqueLaw> pd_law(std::shared_ptr<MotionLaw> reference, double kp, double kd,
+                                  std::shared_ptr<TorqueLaw> feedforward) {
+  return std::make_shared<PdTorque>(std::move(reference), kp, kd, std::move(feedforward));
+}
 
 std::shared_ptr<MotionLaw> deployment_law(double psi0, double alpha, double T) {
   return std::make_shared<Deployment>(psi0, alpha, T);

@@ -26,7 +26,13 @@ class MotionLaw {
 class TorqueLaw {
  public:
   virtual ~TorqueLaw() = default;
+  /// τ(t) of an open-loop law; for a feedback law the torque on its reference trajectory.
   virtual double at(double t) const = 0;
+  /// τ at time t and the joint's own coordinate q and rate v (feedback laws; others ignore q, v).
+  virtual double at(double t, double /*q*/, double /*v*/) const { return at(t); }
+  /// −∂τ/∂q and −∂τ/∂v: what a feedback law adds to the joint's stiffness and damping (Newton matrix).
+  virtual double stiffness() const { return 0.0; }
+  virtual double damping() const { return 0.0; }
   virtual std::vector<double> breakpoints() const { return {}; }
 };
 
@@ -48,6 +54,12 @@ std::shared_ptr<TorqueLaw> tabulated_torque(std::vector<double> t, std::vector<d
 /// earlier run); t outside the table is an error.
 std::shared_ptr<TorqueLaw> spline_torque(std::vector<double> t, std::vector<double> tau);
 /// Any callable τ(t), smooth except at the given times.
+/// PD feedback on a reference motion with an optional feed-forward torque (issue 10 §6):
+///   τ = τ_ff(t) + k_p (q_ref(t) − q) + k_d (q̇_ref(t) − q̇).
+/// With the rigid manipulator's inverse dynamics of the references as τ_ff (computed torque) the
+/// feedback only corrects what the link's flexibility adds. kp, kd ≥ 0; ff may be null.
+std::shared_ptr<TorqueLaw> pd_law(std::shared_ptr<MotionLaw> reference, double kp, double kd,
+                                  std::shared_ptr<TorqueLaw> feedforward);
 std::shared_ptr<TorqueLaw> torque_function(std::function<double(double)> f, std::vector<double> breakpoints = {});
 
 /// Reads a two-column CSV (time, value), '#' comments and one optional header line allowed.

@@ -1,5 +1,7 @@
 #include "solvers/newton_system.hpp"
 
+#include <stdexcept>
+
 namespace rfem {
 
 NewtonSystem::NewtonSystem(const Model& model, std::vector<int> base_col, int nb, LinearSolverKind kind,
@@ -21,9 +23,22 @@ bool NewtonSystem::setup(const VecX& q, const VecX& v, double h) {
   if (keep_stiffness_) extra.push_back({&K_, 1.0, 0.0});
   if (damped_) extra.push_back({&C_, 0.0, 1.0});
   assemble_matrices(model_, pattern_, base_col_, q, v, terms, S_, extra, &base_rows_, &ws_);
+  const int nb = pattern_.n_base();
+  for (int c = 0; c < static_cast<int>(kp_.size()); ++c) {
+    const long d = pattern_.base() + static_cast<long>(c) * nb + c;
+    S_[d] += h * kd_[c] + h * h * kp_[c];
+    if (keep_stiffness_) K_[d] += kp_[c];
+  }
   h_ = h;
   solver_->set_threads(ws_.parallel.team(model_.n()));
   return solver_->factorize(S_);
+}
+
+void NewtonSystem::set_joint_feedback(std::vector<double> kp, std::vector<double> kd) {
+  if (static_cast<int>(kp.size()) != pattern_.n_base() || kd.size() != kp.size())
+    throw std::invalid_argument("one feedback gain pair per unknown joint is required");
+  kp_ = std::move(kp);
+  kd_ = std::move(kd);
 }
 
 void NewtonSystem::solve(VecX& b) const {

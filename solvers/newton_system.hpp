@@ -20,6 +20,9 @@ class NewtonSystem {
   /// scratch of the assembly), or null for one of its own. `keep_stiffness`: keep K (IDA's solve).
   NewtonSystem(const Model& model, std::vector<int> base_col, int nb, LinearSolverKind kind = LinearSolverKind::Chain,
                Workspace* ws = nullptr, bool keep_stiffness = false);
+  /// Stiffness and damping a feedback law adds on the unknown joints' diagonal (one per unknown
+  /// joint, in column order): S gains h kd + h² kp, IDA's K gains kp.
+  void set_joint_feedback(std::vector<double> kp, std::vector<double> kd);
   /// Assembles S(h) at a state (full coordinates) and factorises it. False if not positive definite.
   bool setup(const VecX& q, const VecX& v, double h);
   /// Solves S(h) x = b in place (the h of the last setup).
@@ -41,7 +44,7 @@ class NewtonSystem {
   std::vector<int> base_col_;
   BorderedPattern pattern_;
   std::unique_ptr<LinearSolver> solver_;
-  std::vector<double> S_, K_, C_;
+  std::vector<double> S_, K_, C_, kp_, kd_;
   MatX base_rows_;
   bool damped_, keep_stiffness_;
   double h_ = 0.0;
