@@ -289,11 +289,15 @@ std::map<std::string, T> read_named(const Reader& r, const toml::table& root, co
   return out;
 }
 
+// A rigid body: `extra` names keys the caller reads itself (a payload's `at`).
 Mat4 read_body(const Reader& r, const toml::table& t, const std::string& path,
-               const std::map<std::string, Material>& mats, const std::map<std::string, Section>& secs) {
+               const std::map<std::string, Material>& mats, const std::map<std::string, Section>& secs,
+               const std::set<std::string>& extra = {}) {
   if (t.get("section")) {
     // Uniform prismatic link along its frame's x axis from the origin.
-    r.check_keys(t, path, {"section", "material", "length"});
+    std::set<std::string> keys{"section", "material", "length"};
+    keys.insert(extra.begin(), extra.end());
+    r.check_keys(t, path, keys);
     const std::string sn = r.string(t, path, "section"), mn = r.string(t, path, "material");
     if (!secs.count(sn)) r.fail(t.get("section"), path + ".section", "no section named '" + sn + "'");
     if (!mats.count(mn)) r.fail(t.get("material"), path + ".material", "no material named '" + mn + "'");
@@ -306,7 +310,9 @@ Mat4 read_body(const Reader& r, const toml::table& t, const std::string& path,
     I(2, 2) = mass * L * L / 12.0 + rho * L * s.Iz;
     return pseudo_inertia(mass, Vec3(0.5 * L, 0, 0), I);
   }
-  r.check_keys(t, path, {"mass", "com", "inertia"});
+  std::set<std::string> keys{"mass", "com", "inertia"};
+  keys.insert(extra.begin(), extra.end());
+  r.check_keys(t, path, keys);
   const double mass = r.non_negative(t, path, "mass", 0.0);
   const Vec3 com = r.vec3(t, path, "com", Vec3::Zero());
   Mat3 I = Mat3::Zero();
@@ -477,7 +483,7 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
   if (const toml::node* ln = root.get("link")) {
     if (!ln->is_table()) r.fail(ln, "link", "must be a table");
     const toml::table& lt = *ln->as_table();
-    r.check_keys(lt, "link", {"n", "damping_beta", "mount", "segments"});
+    r.check_keys(lt, "link", {"n", "damping_beta", "mount", "segments", "payloads"});
     c.has_link = true;
     c.n = static_cast<int>(r.integer(lt, "link", "n", 0, 1, kMaxRfes));
     c.link.damping_beta = r.non_negative(lt, "link", "damping_beta", 0.0);
@@ -504,6 +510,24 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
       if (!st.get("parts") && c.n == 0) r.fail(&st, p + ".parts", "missing (give parts per segment or link.n)");
       s.parts = static_cast<int>(r.integer(st, p, "parts", 1, 1, kMaxRfes));
       c.link.segments.push_back(s);
+    }
+    if (const toml::node* pn = lt.get("payloads")) {
+      auto pa = pn->as_array();
+      if (!pa || !pa->is_array_of_tables()) r.fail(pn, "link.payloads", "must be an array of tables ([[link.payloads]])");
+      const double L = c.link.total_length();
+      for (size_t i = 0; i < pa->size(); ++i) {
+        const toml::table& pt = *pa->get(i)->as_table();
+        const std::string p = "link.payloads." + std::to_string(i);
+        Payload pl;
+        if (const toml::node* an = pt.get("at"); an && an->is_string() && an->as_string()->get() == "tip") pl.at = L;
+        else pl.at = r.number(pt, p, "at");
+        if (pl.at < 0.0 || pl.at > L * (1 + 1e-12))
+          r.fail(pt.get("at"), p + ".at", "must lie on the link, 0 to " + Reader::fmt(L) + " m, or be \"tip\" (got " + Reader::fmt(pl.at) + ")");
+        pl.at = std::min(pl.at, L);
+        pl.H = read_body(r, pt, p, mats, secs, {"at"});
+        if (pl.H(3, 3) <= 0.0) r.fail(&pt, p + ".mass", "a payload needs a positive mass");
+        c.link.payloads.push_back(pl);
+      }
     }
     if (c.n > 0 && c.n < static_cast<int>(c.link.segments.size()))
       r.fail(lt.get("n"), "link.n", "n = " + std::to_string(c.n) + " cannot cover " +

@@ -50,6 +50,13 @@ Rfe make_rfe(const FlexibleLink& link, const std::vector<double>& seg_start, dou
     const double hi = std::min(b, seg_start[s] + link.segments[s].length);
     if (hi - lo > 1e-14 * link.total_length()) G += piece_moments(link.segments[s], lo, hi);
   }
+  const double L = link.total_length();
+  for (const Payload& p : link.payloads)  // spans are [a, b), the last one [a, L]
+    if (p.at >= a && (p.at < b || (b >= L && p.at <= L))) {
+      Mat4 T = Mat4::Identity();  // moments about {r}'s origin: T H Tᵀ with T = Trans(at, 0, 0)
+      T(0, 3) = p.at;
+      G += T * p.H * T.transpose();
+    }
   Rfe r;
   r.mass = G(3, 3);
   r.centre = G.topRightCorner<3, 1>() / r.mass;

@@ -16,8 +16,17 @@ struct Segment {
   int parts = 1;        ///< equal parts (= sdes) in this segment
 };
 
+/// A rigid body fixed to the link (issue 10 §4): a point mass or a body with inertia, e.g. an end
+/// effector at the tip. It moves with the rfe whose span contains `at` (the last rfe for the tip),
+/// whose mass, mass centre and inertia it joins.
+struct Payload {
+  double at = 0.0;          ///< position along the link axis of its reference point [m], 0 < at ≤ L
+  Mat4 H = Mat4::Zero();    ///< pseudo-inertia about the reference point (at, 0, 0), {r} axes
+};
+
 struct FlexibleLink {
   std::vector<Segment> segments;
+  std::vector<Payload> payloads;
   double damping_beta = 0.0;  ///< stiffness-proportional sde damping d = β c [s]
   double total_length() const;
 };

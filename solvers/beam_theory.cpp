@@ -17,6 +17,26 @@ double cantilever_beta_l(int k) {
   return x;
 }
 
+double cantilever_tip_mass_beta_l(double mu, double eta, int k) {
+  auto f = [&](double x) {  // the frequency equation divided by cosh x (no overflow)
+    const double c = std::cos(x), s = std::sin(x), h = 1.0 / std::cosh(x), t = std::tanh(x);
+    return h + c + x * mu * (c * t - s) - x * x * x * eta * (s + t * c) + x * x * x * x * mu * eta * (h - c);
+  };
+  int found = 0;
+  const double dx = 1e-3;  // roots are ~π apart or more; the scan cannot step over a pair
+  for (double a = dx; a < 1e3; a += dx) {
+    if (f(a) * f(a + dx) > 0.0) continue;
+    if (++found < k) continue;
+    double lo = a, hi = a + dx;
+    for (int it = 0; it < 200 && hi - lo > 1e-15 * hi; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (f(lo) * f(mid) <= 0.0 ? hi : lo) = mid;
+    }
+    return 0.5 * (lo + hi);
+  }
+  return NAN;
+}
+
 double cantilever_omega(const Segment& s, ModeKind kind, int k) {
   const double L = s.length, E = s.material.E, G = s.material.G, rho = s.material.rho;
   const Section& c = s.section;

@@ -8,6 +8,12 @@ namespace rfem::beam {
 
 /// k-th root (k ≥ 1) of 1 + cos x cosh x = 0: 1.875104, 4.694091, 7.854757, …
 double cantilever_beta_l(int k);
+/// k-th root λ = βL of the Euler–Bernoulli cantilever carrying at its free end a mass μ·ρAL with
+/// rotary inertia η·ρAL³ about the tip:
+///   1 + cos λ cosh λ + λμ(cos λ sinh λ − sin λ cosh λ) − λ³η(sin λ cosh λ + cos λ sinh λ)
+///     + λ⁴μη(1 − cos λ cosh λ) = 0
+/// (μ = η = 0: the free end; μ → ∞: pinned, tan λ = tanh λ; η → ∞: guided, tan λ = −tanh λ).
+double cantilever_tip_mass_beta_l(double mu, double eta, int k);
 /// k-th natural circular frequency [rad/s] of a uniform cantilever of the given kind.
 double cantilever_omega(const Segment& s, ModeKind kind, int k);
 /// k-th bending frequency [rad/s] of a uniform Timoshenko cantilever (shear deformation and rotary

@@ -19,13 +19,14 @@ struct ModesResult {
   std::vector<ModeKind> kind;  ///< dominant motion (BendingY: deflection along y)
   VecX q0;                ///< the equilibrium linearised about
   bool dense = true;      ///< which eigen-solver ran
-  double shift = 0.0;     ///< Lanczos: the shift of the last solve
-  /// ‖Kφ − λMφ‖ / (‖Kφ‖ + |λ|‖Mφ‖) of each mode: round-off is ~1e-12; above kResidualTolerance the
-  /// eigen-solution cannot be trusted (commands warn).
-  VecX residual;
+  /// Lanczos: relative change of each eigenvalue λ = ω² between two solves with different shifts
+  /// (σ = 0 and σ = −λ₁): the round-off the stiff sdes put into the factorisation of K − σM,
+  /// which grows like n². Above kUncertaintyTolerance the frequency is not trustworthy at this n
+  /// (commands warn). Zero for the dense solver.
+  VecX uncertainty;
 };
 
-constexpr double kResidualTolerance = 1e-8;
+constexpr double kUncertaintyTolerance = 1e-8;
 
 /// Lowest `count` modes. `vb` are the steady joint rates (empty or zero: no rotation).
 /// `dense_limit`: largest 6n solved densely.

@@ -26,7 +26,18 @@ PY
 for sig in INT TERM; do
   "$rfem" run "$src/cases/paper_deployment.toml" --n 2000 --quiet -o "$sig.h5" &
   pid=$!
-  sleep 3
+  # Interrupt once the kinematic run has written two outputs (read live, SWMR), not after a fixed
+  # time: a busy machine may not get that far in 3 s.
+  for _ in $(seq 600); do
+    /usr/bin/python3 - "$sig.h5" 2>/dev/null <<'PY' && break
+import sys, h5py
+f = h5py.File(sys.argv[1], "r", libver="latest", swmr=True)
+d = f["kinematic/time"]
+d.refresh()
+sys.exit(0 if d.shape[0] >= 2 else 1)
+PY
+    sleep 0.1
+  done
   kill -"$sig" "$pid"
   wait "$pid"
   code=$?

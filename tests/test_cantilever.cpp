@@ -60,6 +60,36 @@ TEST(Cantilever, BendingFrequenciesConvergeWithOrderTwoInBothPlanes) {
   EXPECT_NEAR(beam::cantilever_beta_l(3), 7.854757, 1e-6);
 }
 
+TEST(Cantilever, TipPayloadMatchesTheTipMassFrequencyEquation) {
+  // cases/kane_tip_mass.toml (issue 10 §4, §8): a 6 kg end effector (μ = M/ρAL = 0.5) with 1.2 kg m²
+  // about its centre on the tip (η = J/ρAL³ = 1e-3), Iz raised as above. Its bending frequencies
+  // converge with order 2 to the Euler–Bernoulli cantilever with tip mass and rotary inertia, up to
+  // the same Timoshenko bound as the free cantilever's (the payload adds no shear of its own).
+  // Without the payload, or with it on the wrong rfe, mode 1 would be 40 % higher.
+  const Case c = read_case(test::source_path("cases/kane_tip_mass.toml"), {"sections.kane.Iz=3e-7"});
+  const Segment& seg = c.link.segments[0];
+  const double rhoA = seg.material.rho * seg.section.A, L = seg.length, mu = 6.0 / (rhoA * L), eta = 1.2 / (rhoA * L * L * L);
+  ASSERT_EQ(c.link.payloads.size(), 1u);
+  for (const auto& [name, I] : {std::pair{"bending-y", seg.section.Iz}, std::pair{"bending-z", seg.section.Iy}}) {
+    for (int k = 1; k <= 2; ++k) {
+      const Series s = series(c, std::string(name) + ":" + std::to_string(k));
+      const double lam = beam::cantilever_tip_mass_beta_l(mu, eta, k);
+      const double exact = lam * lam / (L * L) * std::sqrt(seg.material.E * I / rhoA) / (2 * M_PI);
+      char rel[32];
+      std::snprintf(rel, sizeof rel, "%.2e", s.richardson() / exact - 1.0);
+      RecordProperty(std::string(name) + std::to_string(k) + "_richardson_error", rel);
+      EXPECT_NEAR(s.order(), 2.0, 0.15) << name << k;
+      EXPECT_LT(std::abs(s.richardson() / exact - 1.0), timoshenko_bound(seg, lam, I)) << name << k;
+    }
+  }
+  // The frequency equation's limits: no payload is the free cantilever; a huge mass pins the tip for
+  // every mode but the first: the mass on the beam's spring 3EI/L³, λ → (3/μ)^¼.
+  EXPECT_NEAR(beam::cantilever_tip_mass_beta_l(0.0, 0.0, 2), beam::cantilever_beta_l(2), 1e-12);
+  EXPECT_NEAR(beam::cantilever_tip_mass_beta_l(1.0, 0.0, 1), 1.247917, 1e-6);  // M = beam mass (tables)
+  EXPECT_NEAR(beam::cantilever_tip_mass_beta_l(1e9, 0.0, 2), 3.926602, 1e-5);  // clamped–pinned
+  EXPECT_NEAR(beam::cantilever_tip_mass_beta_l(1e9, 0.0, 1), std::pow(3.0 / 1e9, 0.25), 1e-6);
+}
+
 TEST(Cantilever, AxialAndTorsionalFrequenciesConverge) {
   const Case c = kane();
   const Segment& seg = c.link.segments[0];
