@@ -7,4 +7,6 @@ cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRFEM_SANIT
 cmake --build build-asan -j "$(nproc)"
 # detect_leaks: LeakSanitizer on; halt_on_error: the first finding fails the test.
 export ASAN_OPTIONS=detect_leaks=1:halt_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -L unit
+# readme_transcripts is left out: it compares README's text with the Release program's output to
+# the last printed digit, and this build (RelWithDebInfo, instrumented) rounds differently.
+ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -L unit -E '^readme_transcripts$'

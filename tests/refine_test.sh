@@ -37,7 +37,7 @@ test -s figs/refine_convergence.png && test -s figs/refine_convergence_q1.png ||
 # Interrupted: exit 130, the rows done so far in the file and on stdout.
 "$rfem" refine "$src/cases/paper_deployment.toml" --n 6,8,4000 --quantity force/peak:u1 -q -o part.h5 > part.txt &
 pid=$!
-for i in $(seq 1 200); do
+for i in $(seq 1 3000); do  # until n = 4000 starts (a sanitizer build needs minutes for n = 6, 8)
   /usr/bin/python3 -c "import h5py,sys; f=h5py.File('part.h5','r',swmr=True); sys.exit(0 if 'n4000' in f else 1)" 2>/dev/null && break
   sleep 0.1
 done

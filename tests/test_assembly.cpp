@@ -40,8 +40,8 @@ std::vector<double> newton_values(const Model& m, const BorderedPattern& p, cons
 
 TEST(Assembly, SparseEqualsDenseReferenceWithOneAndTwoThreads) {
   Model m = test::spatial_arm(7, 0.002);
-  m.joints[0].drive = {0.4, 0.8, 0.3, 0.5};  // rotor inertia, damping and friction on two joints
-  m.joints[2].drive = {0.1, 0.0, 0.2, 0.05};
+  m.joints[0].drive = {0.4, 0.8, 0.3, 0.5};  // rotor inertia, damping and friction on both joints
+  m.joints[1].drive = {0.1, 0.0, 0.2, 0.05};
   VecX q, v, a;
   test::random_state(m, 11, q, v, a);
   const BorderedPattern p(m.n(), m.m());
