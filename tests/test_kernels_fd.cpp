@@ -62,21 +62,48 @@ MatX assembled(const Model& m, const VecX& q, const VecX& v, const MatrixTerms& 
   return to_dense(p, vals);
 }
 
+// M (sparse and dense) against the Hessian of T in q̇: T is quadratic in q̇, ∂T/∂q̇ = M q̇, so the
+// Jacobian of the FD gradient is M. Returns the assembled M.
+MatX expect_mass_is_hessian_of_kinetic_energy(const Model& m, const VecX& q, const VecX& v) {
+  MatrixTerms t;
+  t.mass = 1.0;
+  const MatX M = assembled(m, q, v, t);
+  auto grad = [&](const VecX& vv) {
+    return fd_gradient([&](const VecX& x) { return energies(m, q, x).kinetic; }, vv, 1e-3);
+  };
+  const MatX Mfd = fd_jacobian(grad, v, 1e-3);
+  EXPECT_LT(rel(M, Mfd), 1e-6);
+  EXPECT_LT(rel(dense_mass_matrix(m, q), Mfd), 1e-6);
+  return M;
+}
+
+// C (sparse and dense) against the Jacobian of the dissipative forces in q̇, and the dissipated
+// power against q̇ · f_d.
+void expect_damping_is_jacobian_of_dissipative_forces(const Model& m, const VecX& q, const VecX& v) {
+  const VecX zero = VecX::Zero(m.dof());
+  MatrixTerms t;
+  t.damping = 1.0;
+  auto fd = [&](const VecX& x) {
+    VecX f;
+    generalised_forces(m, q, x, zero, only(false, false, true), f);
+    return f;
+  };
+  const MatX Cfd = fd_jacobian(fd, v);
+  EXPECT_LT(rel(assembled(m, q, v, t), Cfd), 1e-6);
+  EXPECT_LT(rel(dense_damping(m, q, v), Cfd), 1e-6);
+  VecX f0;
+  generalised_forces(m, q, zero, zero, only(false, false, true), f0);
+  const double P = v.dot(fd(v) - f0);
+  EXPECT_NEAR(energies(m, q, v).dissipation_rate, P, 1e-9 * std::abs(P));
+}
+
 }  // namespace
 
 TEST(KernelsFD, MassMatrixIsHessianOfKineticEnergy) {
   const Model m = test::spatial_arm(4);
   VecX q, v, a;
   test::random_state(m, 1, q, v, a);
-  MatrixTerms t;
-  t.mass = 1.0;
-  const MatX M = assembled(m, q, v, t);
-  // T is quadratic in q̇: ∂T/∂q̇ = M q̇, so the Jacobian of the FD gradient is M.
-  auto grad = [&](const VecX& vv) {
-    return fd_gradient([&](const VecX& x) { return energies(m, q, x).kinetic; }, vv, 1e-3);
-  };
-  const MatX Mfd = fd_jacobian(grad, v, 1e-3);
-  EXPECT_LT(rel(M, Mfd), 1e-6);
+  const MatX M = expect_mass_is_hessian_of_kinetic_energy(m, q, v);
   EXPECT_LT(rel(M, M.transpose()), 1e-15);
   Eigen::SelfAdjointEigenSolver<MatX> es(M);
   EXPECT_GT(es.eigenvalues().minCoeff(), 0.0) << "M must be positive definite";
@@ -134,23 +161,11 @@ TEST(KernelsFD, StiffnessIsJacobianOfElasticAndGravityForces) {
 }
 
 TEST(KernelsFD, DampingMatrixIsJacobianOfDampingForces) {
+  // The sde damping is a Rayleigh function of degree 2 in the rates.
   const Model m = test::spatial_arm(4, 0.01);
   VecX q, v, a;
   test::random_state(m, 5, q, v, a);
-  const VecX zero = VecX::Zero(m.dof());
-  MatrixTerms t;
-  t.damping = 1.0;
-  const MatX C = assembled(m, q, v, t);
-  auto fd = [&](const VecX& x) {
-    VecX f;
-    generalised_forces(m, q, x, zero, only(false, false, true), f);
-    return f;
-  };
-  EXPECT_LT(rel(C, fd_jacobian(fd, v)), 1e-6);
-  // Dissipated power equals q̇ · f_damping (Rayleigh function of degree 2).
-  VecX f0;
-  generalised_forces(m, q, zero, zero, only(false, false, true), f0);
-  EXPECT_NEAR(energies(m, q, v).dissipation_rate, v.dot(fd(v) - f0), 1e-9 * std::abs(v.dot(fd(v) - f0)));
+  expect_damping_is_jacobian_of_dissipative_forces(m, q, v);
 }
 
 TEST(KernelsFD, JointDrivesAreConsistent) {
@@ -164,25 +179,8 @@ TEST(KernelsFD, JointDrivesAreConsistent) {
   const Model bare = test::spatial_arm(3, 0.01);
   VecX q, v, a;
   test::random_state(m, 8, q, v, a);
-  const VecX zero = VecX::Zero(m.dof());
-  MatrixTerms tm;
-  tm.mass = 1.0;
-  const MatX Mfd = fd_jacobian([&](const VecX& x) { return fd_gradient([&](const VecX& y) { return energies(m, q, y).kinetic; }, x); }, v, 1e-4);
-  EXPECT_LT(rel(assembled(m, q, v, tm), Mfd), 1e-6);
-  EXPECT_LT(rel(dense_mass_matrix(m, q), Mfd), 1e-6);
-  MatrixTerms tc;
-  tc.damping = 1.0;
-  auto fd = [&](const VecX& x) {
-    VecX f;
-    generalised_forces(m, q, x, zero, only(false, false, true), f);
-    return f;
-  };
-  const MatX Cfd = fd_jacobian(fd, v);
-  EXPECT_LT(rel(assembled(m, q, v, tc), Cfd), 1e-6);
-  EXPECT_LT(rel(dense_damping(m, q, v), Cfd), 1e-6);
-  VecX f0;
-  generalised_forces(m, q, zero, zero, only(false, false, true), f0);
-  EXPECT_NEAR(energies(m, q, v).dissipation_rate, v.dot(fd(v) - f0), 1e-9 * std::abs(v.dot(fd(v) - f0)));
+  expect_mass_is_hessian_of_kinetic_energy(m, q, v);
+  expect_damping_is_jacobian_of_dissipative_forces(m, q, v);
   VecX F, Fb;
   double P = 0.0, Pb = 0.0;
   generalised_forces(m, q, v, a, ForceTerms{}, F, &P);
