@@ -151,6 +151,8 @@ RunGroup::RunGroup(ResultsFile& file, const std::string& name, const Model& mode
              "the paper's tip deflections: u1 along y of {r}, u2 along z of {r}, theta the torsion phi1 of rfe_n");
   add_series("energy", {"kinetic", "elastic", "gravity", "input_work", "dissipated", "balance"},
              {"J", "J", "J", "J", "J", "J"}, "balance = kinetic + elastic + gravity + dissipated - input_work");
+  add_series("momentum", {"px", "py", "pz", "Lx", "Ly", "Lz"}, {"kg m/s", "kg m/s", "kg m/s", "kg m2/s", "kg m2/s", "kg m2/s"},
+             "linear momentum and angular momentum about the origin of {0} of every body (drive rotors left out)");
   if (flexible_every_ > 0 && n > 0) {
     add_series("flexible_time", {"t"}, {"s"});
     std::vector<std::string> cols, units;
@@ -270,6 +272,9 @@ void RunGroup::append(const OutputSample& s) {
   const double e[6] = {s.energy.kinetic, s.energy.elastic, s.energy.gravity, s.input_work, s.dissipated,
                        total + s.dissipated - s.input_work};
   write_row("energy", rows_, e);
+  const double mom[6] = {s.momentum.linear.x(),  s.momentum.linear.y(),  s.momentum.linear.z(),
+                         s.momentum.angular.x(), s.momentum.angular.y(), s.momentum.angular.z()};
+  write_row("momentum", rows_, mom);
   if (flexible_every_ > 0 && model_.n() > 0 && rows_ % flexible_every_ == 0) {
     write_row("flexible_time", flex_rows_, &s.t);
     write_row("flexible_q", flex_rows_, s.q.data());

@@ -123,4 +123,14 @@ double rfe_kinetic_energy(const Rfe& rfe, const RfePose& p, const BaseKinematics
   return 0.5 * trace_AHBt(Wd, rfe.H, Wd);
 }
 
+void rfe_momentum_moments(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, const Vec6& v, Vec3& lin,
+                          Mat3& A) {
+  Mat4 P = p.d.D;
+  P.topRightCorner<3, 1>() += rfe.centre;
+  const Mat34 Wd = (bk.B0d * P).topRows<3>() + lift(bk.B0, d_dot(p.d, v));
+  const Mat34 WH = p.W.topRows<3>() * rfe.H;
+  lin = Wd * rfe.H.col(3);
+  A = WH * Wd.transpose();
+}
+
 }  // namespace rfem

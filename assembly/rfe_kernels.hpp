@@ -57,5 +57,9 @@ Mat6 rfe_inertial_stiffness(const Rfe& rfe, const RfePose& p, const BaseKinemati
 
 /// Kinetic energy ½ tr(Ẇ H Ẇᵀ) with Ẇ = Ḃ0 P + B0 Ṗ.
 double rfe_kinetic_energy(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, const Vec6& v);
+/// ∫ ẋ dm (rows 0–2 of col 3) and ∫ x ẋᵀ dm (top-left 3×3) of the rfe in {0}: W H Ẇᵀ with
+/// column 3 replaced by Ẇ H e₄ (momentum.hpp turns them into linear and angular momentum).
+void rfe_momentum_moments(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, const Vec6& v, Vec3& lin,
+                          Mat3& A);
 
 }  // namespace rfem

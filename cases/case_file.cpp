@@ -440,6 +440,48 @@ Simulation read_simulation(const Reader& r, const toml::table& t) {
   return s;
 }
 
+// [base] kind = "free": six joints (free_base_joints) ahead of [[joints]], torque-free, starting
+// at the given pose and rates; the bus body rides on the last.
+void read_base(const Reader& r, const toml::node* bn, const std::map<std::string, Material>& mats,
+               const std::map<std::string, Section>& secs,
+               const std::string& path, Case& c) {
+  if (!bn->is_table()) r.fail(bn, "base", "must be a table {kind = \"free\", body = …}");
+  const toml::table& bt = *bn->as_table();
+  r.check_keys(bt, "base", {"kind", "body", "position", "velocity", "yaw", "pitch", "roll", "yaw_rate", "pitch_rate",
+                            "roll_rate"});
+  const std::string kind = r.string(bt, "base", "kind", std::string("fixed"));
+  if (kind == "fixed") {
+    if (bt.size() > 1) r.fail(&bt, "base", "a fixed base takes no other keys (kind = \"free\" for a floating one)");
+    return;
+  }
+  if (kind != "free") r.fail(bt.get("kind"), "base.kind", "must be \"fixed\" or \"free\" (got \"" + kind + "\")");
+  const toml::node* body = bt.get("body");
+  if (!body || !body->is_table()) r.fail(body ? body : &bt, "base.body", "a free base needs a body table {mass, com, inertia}");
+  const Mat4 H = read_body(r, *body->as_table(), "base.body", mats, secs);
+  if (!(H(3, 3) > 0.0)) r.fail(body, "base.body.mass", "a free base needs a positive mass");
+  const Vec3 x = r.vec3(bt, "base", "position", Vec3::Zero()), xd = r.vec3(bt, "base", "velocity", Vec3::Zero());
+  const double att[3] = {r.angle(bt, "base", "yaw", 0.0), r.angle(bt, "base", "pitch", 0.0), r.angle(bt, "base", "roll", 0.0)};
+  const double rates[3] = {r.number(bt, "base", "yaw_rate", 0.0), r.number(bt, "base", "pitch_rate", 0.0),
+                           r.number(bt, "base", "roll_rate", 0.0)};
+  if (std::abs(att[1]) >= free_base_pitch_limit)
+    r.fail(bt.get("pitch"), "base.pitch", "must lie within ±" + Reader::fmt(free_base_pitch_limit * 180 / M_PI) +
+                                              "° (yaw–pitch–roll angles are singular at ±90°)");
+  std::vector<Joint> js = free_base_joints(H);
+  const long m0 = c.joint_values.size();
+  VecX values(m0 + free_base_dofs), rates_all(m0 + free_base_dofs);
+  values << x, att[0], att[1], att[2], c.joint_values;
+  rates_all << xd, rates[0], rates[1], rates[2], c.joint_rates;
+  c.joint_values = values;
+  c.joint_rates = rates_all;
+  std::vector<InputSpec> ins(free_base_dofs);
+  std::ostringstream where;
+  where << path << ":" << bt.source().begin.line << ": base";
+  for (InputSpec& in : ins) in.where = where.str();
+  c.inputs.insert(c.inputs.begin(), ins.begin(), ins.end());
+  c.joints.insert(c.joints.begin(), js.begin(), js.end());
+  c.free_base = true;
+}
+
 }  // namespace
 
 Case read_case(const std::string& path, const std::vector<std::string>& overrides) {
@@ -467,7 +509,7 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
     c.effective_text = os.str();
   }
   const Reader r(path);
-  r.check_keys(root, "", {"case", "materials", "sections", "link", "joints", "gravity", "loads", "simulation"});
+  r.check_keys(root, "", {"case", "materials", "sections", "link", "joints", "gravity", "loads", "simulation", "base"});
   const auto slash = path.find_last_of('/');
   const std::string case_dir = slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
 
@@ -542,7 +584,7 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
     for (size_t i = 0; i < arr->size(); ++i) {
       const toml::table& jt = *arr->get(i)->as_table();
       const std::string p = "joints." + std::to_string(i);
-      r.check_keys(jt, p, {"name", "type", "alpha", "a", "theta", "d", "value", "rate", "body", "drive", "input"});
+      r.check_keys(jt, p, {"name", "type", "alpha", "a", "theta", "d", "axis", "value", "rate", "body", "drive", "input"});
       Joint j;
       j.name = r.string(jt, p, "name", "joint" + std::to_string(i + 1));
       const std::string type = r.string(jt, p, "type", std::string("revolute"));
@@ -553,6 +595,9 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
       j.a = r.number(jt, p, "a", 0.0);
       j.theta = r.angle(jt, p, "theta", 0.0);
       j.d = r.number(jt, p, "d", 0.0);
+      j.axis = r.vec3(jt, p, "axis", Vec3::UnitZ());
+      if (!(j.axis.norm() > 0.0)) r.fail(jt.get("axis"), p + ".axis", "must be a non-zero direction");
+      j.axis.normalize();
       c.joint_values[static_cast<long>(i)] =
           j.type == JointType::Revolute ? r.angle(jt, p, "value", 0.0) : r.number(jt, p, "value", 0.0);
       c.joint_rates[static_cast<long>(i)] = r.number(jt, p, "rate", 0.0);
@@ -578,6 +623,7 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
       c.joints.push_back(j);
     }
   }
+  if (const toml::node* bn = root.get("base")) read_base(r, bn, mats, secs, path, c);
   if (!c.has_link && c.joints.empty()) r.fail(&root, "link", "a case needs a flexible link, joints, or both");
 
   if (const toml::node* gn = root.get("gravity")) {
@@ -589,6 +635,9 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
     if (!sn->is_table()) r.fail(sn, "simulation", "must be a table");
     c.sim = read_simulation(r, *sn->as_table());
     c.has_simulation = true;
+    if (c.sim.procedure == "paper" && c.free_base)
+      r.fail(sn->as_table()->get("procedure"), "simulation.procedure",
+             "the paper procedure prescribes every joint; a free base has none to prescribe");
     if (c.sim.procedure == "paper")
       for (const InputSpec& in : c.inputs)
         if (!in.prescribed())
@@ -619,7 +668,9 @@ Model build_model(const Case& c, int n) {
     }
     d = discretise(link);
   }
-  return make_model(c.joints, c.mount, std::move(d), c.gravity);
+  Model m = make_model(c.joints, c.mount, std::move(d), c.gravity);
+  m.free_base = c.free_base;
+  return m;
 }
 
 }  // namespace rfem

@@ -54,7 +54,8 @@ struct Case {
   FlexibleLink link;
   int n = 0;                       ///< link.n if given (0: each segment's parts)
   Mat4 mount = Mat4::Identity();
-  std::vector<Joint> joints;
+  std::vector<Joint> joints;       ///< a free base's six joints first, then [[joints]]
+  bool free_base = false;          ///< [base] kind = "free"
   VecX joint_values, joint_rates;  ///< initial/held values and steady rates
   double gravity = 0.0;
   TipLoads loads;

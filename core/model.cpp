@@ -22,7 +22,9 @@ Model rigidify(const Model& model) {
     const Mat4 X = model.mount * homogeneous(Mat3::Identity(), r.centre);
     joints.back().H += X * r.H * X.transpose();
   }
-  return make_model(std::move(joints), model.mount, Discretisation{}, model.gravity);
+  Model r = make_model(std::move(joints), model.mount, Discretisation{}, model.gravity);
+  r.free_base = model.free_base;
+  return r;
 }
 
 }  // namespace rfem

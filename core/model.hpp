@@ -13,6 +13,8 @@ struct Model {
   Mat4 mount = Mat4::Identity();  ///< {r} in the frame of the last base link
   Discretisation link;        ///< n = 0 is the rigid manipulator
   double gravity = 0.0;       ///< g [m/s²], acting along −z of {0}
+  /// Joints 0–5 are a free-floating base (free_base_joints): x, y, z, yaw, pitch, roll.
+  bool free_base = false;
 
   int m() const { return static_cast<int>(joints.size()); }
   int n() const { return link.n(); }

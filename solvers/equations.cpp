@@ -3,6 +3,8 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <chrono>
 #include <stdexcept>
 #include <string>
@@ -133,6 +135,17 @@ OutputSample EquationsOfMotion::sample(double t, const double* qu, const double*
                     : (unknowns() > 0 ? accelerations(t, qu, vu) : VecX());
   VecX r(unknowns());
   residual(t, qu, vu, a.data(), r.data());  // F at these accelerations: the required torques
+  if (model_.free_base) {
+    const double pitch = q_[model_.base_index(free_base_pitch)];
+    if (std::abs(pitch) > free_base_pitch_limit) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "the free base's pitch reached %.1f deg at t = %.6g s: its yaw-pitch-roll angles are singular "
+                    "at +-90 deg (runs stop beyond +-%.0f deg)",
+                    pitch * 180 / M_PI, t, free_base_pitch_limit * 180 / M_PI);
+      throw std::runtime_error(buf);
+    }
+  }
   OutputSample s;
   s.t = t;
   s.q = q_;
@@ -140,6 +153,7 @@ OutputSample EquationsOfMotion::sample(double t, const double* qu, const double*
   s.a = a_;
   s.tau = torques(t);
   s.energy = energies(model_, q_, v_, &ws_);
+  s.momentum = momentum(model_, q_, v_, &ws_);
   s.dissipated = dissipated;
   s.input_work = input_work;
   return s;

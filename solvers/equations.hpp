@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "assembly/assemble.hpp"
+#include "assembly/momentum.hpp"
 #include "solvers/inputs.hpp"
 #include "solvers/newton_system.hpp"
 #include "solvers/thread_governor.hpp"
@@ -21,6 +22,7 @@ struct OutputSample {
   VecX q, v, a;   ///< full coordinates (flexible first, base last)
   VecX tau;       ///< joint torques/forces [N m or N], applied (force input) or required (kinematic)
   Energies energy;
+  Momentum momentum;  ///< of the whole manipulator in {0} (conserved for a free base without gravity)
   double dissipated = 0.0, input_work = 0.0;  ///< integrals since t = 0 [J]
   long steps = 0;        ///< integrator steps taken so far (for progress reports)
   double last_step = 0;  ///< the integrator's last step size [s]

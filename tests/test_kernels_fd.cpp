@@ -97,6 +97,23 @@ void expect_damping_is_jacobian_of_dissipative_forces(const Model& m, const VecX
   EXPECT_NEAR(energies(m, q, v).dissipation_rate, P, 1e-9 * std::abs(P));
 }
 
+// The inertial force against Lagrange's equations: d/dt (M(q(t)) v(t)) along
+// q(t) = q + v t + a t²/2, minus ∂T/∂q.
+void expect_inertial_force_satisfies_lagrange(const Model& m, const VecX& q, const VecX& v, const VecX& a) {
+  VecX eps;
+  generalised_forces(m, q, v, a, only(true, false, false), eps);
+  MatrixTerms t;
+  t.mass = 1.0;
+  auto momentum = [&](double s) {
+    const VecX qs = q + v * s + 0.5 * a * s * s, vs = v + a * s;
+    return VecX(assembled(m, qs, vs, t) * vs);
+  };
+  const double dt = 1e-5;
+  const VecX dpdt = (momentum(dt) - momentum(-dt)) / (2 * dt);
+  const VecX dTdq = fd_gradient([&](const VecX& x) { return energies(m, x, v).kinetic; }, q);
+  EXPECT_LT(rel(eps, dpdt - dTdq), 1e-6);
+}
+
 }  // namespace
 
 TEST(KernelsFD, MassMatrixIsHessianOfKineticEnergy) {
@@ -113,19 +130,18 @@ TEST(KernelsFD, InertialForceSatisfiesLagrangeEquations) {
   const Model m = test::spatial_arm(3);
   VecX q, v, a;
   test::random_state(m, 2, q, v, a);
-  VecX eps;
-  generalised_forces(m, q, v, a, only(true, false, false), eps);
-  MatrixTerms t;
-  t.mass = 1.0;
-  // d/dt (M(q(t)) v(t)) along q(t) = q + v t + a t²/2, minus ∂T/∂q.
-  auto momentum = [&](double s) {
-    const VecX qs = q + v * s + 0.5 * a * s * s, vs = v + a * s;
-    return VecX(assembled(m, qs, vs, t) * vs);
-  };
-  const double dt = 1e-5;
-  const VecX dpdt = (momentum(dt) - momentum(-dt)) / (2 * dt);
-  const VecX dTdq = fd_gradient([&](const VecX& x) { return energies(m, x, v).kinetic; }, q);
-  EXPECT_LT(rel(eps, dpdt - dTdq), 1e-6);
+  expect_inertial_force_satisfies_lagrange(m, q, v, a);
+}
+
+TEST(KernelsFD, JointsAboutAnyAxisAndAFreeBaseAreConsistent) {
+  // The paper's arm on a free bus (case space_deployment): translations along x and y, rotations
+  // about y and x of their joint frames, a bus body of its own. The same checks as for Craig's
+  // z-axis joints hold.
+  const Model m = build_model(read_case(test::source_path("cases/space_deployment.toml")), 3);
+  VecX q, v, a;
+  test::random_state(m, 12, q, v, a);
+  expect_mass_is_hessian_of_kinetic_energy(m, q, v);
+  expect_inertial_force_satisfies_lagrange(m, q, v, a);
 }
 
 TEST(KernelsFD, ForcesAreGradientsOfEnergies) {

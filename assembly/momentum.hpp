@@ -1,0 +1,18 @@
+#pragma once
+// Linear and angular momentum of the whole manipulator (base links, rfes, payloads) in {0}.
+// Without gravity and with no joint fixed to the ground (a free-floating base), both are
+// conserved: the check that vibration and base motion exchange momentum correctly. Rotors of
+// joint drives are not bodies of the model: their reflected inertia is left out.
+#include "assembly/workspace.hpp"
+#include "core/model.hpp"
+
+namespace rfem {
+
+struct Momentum {
+  Vec3 linear = Vec3::Zero();   ///< p = ∫ ẋ dm [kg m/s]
+  Vec3 angular = Vec3::Zero();  ///< L = ∫ x × ẋ dm about the origin of {0} [kg m²/s]
+};
+
+Momentum momentum(const Model& model, const VecX& q, const VecX& v, Workspace* ws = nullptr);
+
+}  // namespace rfem
