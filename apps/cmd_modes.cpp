@@ -12,10 +12,33 @@ namespace rfem::app {
 namespace {
 // Exact cantilever values apply to one uniform segment without payloads on a held, non-rotating
 // base without gravity.
-bool has_exact_reference(const Case& cs, const VecX& vb) {
-  return cs.has_link && cs.link.segments.size() == 1 && cs.link.payloads.empty() && cs.gravity == 0.0 && (vb.size() == 0 || vb.norm() == 0.0) &&
+bool has_exact_reference(const Case& cs, const VecX& vb, bool held) {
+  return held && cs.has_link && cs.link.segments.size() == 1 && cs.link.payloads.empty() && cs.gravity == 0.0 && (vb.size() == 0 || vb.norm() == 0.0) &&
          cs.link.segments[0].section.offset.norm() == 0.0;
 }
+// --free entries: joint numbers from 1, joint names, or "base" (the six of a free base).
+std::vector<int> free_joints(const Case& cs, const Model& model, const std::vector<std::string>& names) {
+  std::vector<int> out;
+  for (const std::string& s : names) {
+    if (s == "base") {
+      if (!model.free_base) throw CaseError(cs.path + ": --free base: the case has no free base ([base] kind = \"free\")");
+      for (int j = 0; j < free_base_dofs; ++j) out.push_back(j);
+      continue;
+    }
+    int j = -1;
+    for (int i = 0; i < model.m(); ++i)
+      if (model.joints[i].name == s) j = i;
+    if (j < 0 && !s.empty() && s.find_first_not_of("0123456789") == std::string::npos && s.size() < 9) j = std::stoi(s) - 1;
+    if (j < 0 || j >= model.m()) {
+      std::string list;
+      for (const Joint& jt : model.joints) list += (list.empty() ? "" : ", ") + jt.name;
+      throw CaseError(cs.path + ": --free " + s + ": no such joint (1 to " + std::to_string(model.m()) + " or " + list + ")");
+    }
+    out.push_back(j);
+  }
+  return out;
+}
+
 }  // namespace
 
 int run_modes(const Common& c, const ModesOptions& o) {
@@ -24,19 +47,30 @@ int run_modes(const Common& c, const ModesOptions& o) {
   if (model.n() == 0) throw CaseError(cs.path + ": link: modal analysis needs a flexible link");
   VecX qb, vb;
   joint_state(cs, o, qb, vb);
-  const int count = std::min(o.count, 6 * model.n());
+  const std::vector<int> freed = free_joints(cs, model, o.free);
+  const int nf = static_cast<int>(freed.size()), all = 6 * model.n() + nf;
+  const int count = std::min(o.count, all);
   if (o.count > count && !c.json)
-    fmt::print(stderr, "rfem: note: --count {} capped at 6n = {} (every mode of n = {} rfes)\n", o.count, count, model.n());
-  const ModesResult r = compute_modes(model, qb, vb, count);
-  const bool exact = has_exact_reference(cs, vb);
-  int seen[4] = {0, 0, 0, 0};
+    fmt::print(stderr, "rfem: note: --count {} capped at 6n{} = {} (every mode of n = {} rfes{})\n", o.count,
+               nf ? fmt::format(" + {}", nf) : "", count, model.n(), nf ? fmt::format(" and {} free joints", nf) : "");
+  ModesResult r;
+  try {
+    r = compute_modes(model, qb, vb, count, 600, freed);
+  } catch (const std::invalid_argument& e) {
+    throw CaseError(cs.path + ": --free: " + e.what());
+  }
+  const bool exact = has_exact_reference(cs, vb, freed.empty());
+  int seen[5] = {0, 0, 0, 0, 0};
+  std::vector<std::string> freed_names;
+  for (int j : freed) freed_names.push_back(model.joints[j].name);
   nlohmann::json modes = nlohmann::json::array();
   // References for one uniform segment: the theory the discretisation converges to (Timoshenko for
   // bending: shear and rotary inertia are in the rfes and sdes; rod theory for axial and torsion
   // modes), and the Euler–Bernoulli value beside it for bending.
   if (!c.json)
-    fmt::print("modes of {} with n = {} rfes ({} solver){}\n{:>4} {:>14} {:>14} {:>12}{}\n",
+    fmt::print("modes of {} with n = {} rfes ({} solver){}{}\n{:>4} {:>14} {:>14} {:>12}{}\n",
                cs.name.empty() ? cs.path : cs.name, model.n(), r.dense ? "dense" : "shift-invert Lanczos",
+               nf ? fmt::format(", free joints {}", fmt::join(freed_names, " ")) : "",
                vb.size() && vb.norm() > 0 ? fmt::format(", joint rates {}", fmt::join(vb.data(), vb.data() + vb.size(), " ")) : "",
                "mode", "f [Hz]", "omega [rad/s]", "kind",
                exact ? fmt::format(" {:>16} {:>10} {:>16}", "reference [Hz]", "error", "Euler-Bern. [Hz]") : "");
@@ -76,6 +110,7 @@ int run_modes(const Common& c, const ModesOptions& o) {
     fmt::print("reference: (T) Timoshenko cantilever (shear and rotary inertia), (rod) rod theory; the error is "
                "the discretisation's and falls as 1/n²\n");
   if (c.json) print_json({{"command", "modes"}, {"case", cs.path}, {"n", model.n()}, {"solver", r.dense ? "dense" : "lanczos"},
+                          {"free_joints", freed_names},
                           {"modes", modes}});
   return 0;
 }

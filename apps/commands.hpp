@@ -27,6 +27,9 @@ struct ModesOptions {
   double rate = 0.0;  ///< --rate: steady rate of joint `joint` [rad/s or m/s]
   int joint = 1;      ///< 1-based
   bool rate_given = false;
+  /// `rfem modes --free`: joints that move with the modes (numbers from 1, names, or "base" for a
+  /// free base's six); empty: every joint held.
+  std::vector<std::string> free;
 };
 
 /// `rfem static`: equilibrium with the joints held, or in the frame of a steady joint rate.

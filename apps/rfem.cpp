@@ -62,9 +62,11 @@ int main(int argc, char** argv) {
   auto* st = app.add_subcommand("static", "static equilibrium under gravity and tip loads, joints held (or turning steadily: --rate)");
   add_common(st, true);
   add_rate(st);
-  auto* md = app.add_subcommand("modes", "natural frequencies and mode shapes of the flexible link, base held");
+  auto* md = app.add_subcommand("modes", "natural frequencies and mode shapes of the flexible link, base held or joints free");
   add_common(md, true);
-  md->add_option("--count", mo.count, "number of modes (at most 6n)")->check(kPositiveInt);
+  md->add_option("--count", mo.count, "number of modes (at most 6n + free joints)")->check(kPositiveInt);
+  md->add_option("--free", mo.free, "joints that move with the modes: numbers from 1, names, or 'base' (a free base's six)")
+      ->delimiter(',');
   add_rate(md);
   auto* rn = app.add_subcommand("run", "time integration of the case's [simulation]; results to HDF5");
   add_common(rn, true);

@@ -17,6 +17,29 @@ double cantilever_beta_l(int k) {
   return x;
 }
 
+namespace {
+// Newton from x0 on f (f' given); the roots below lie within 1e-3 of their asymptotes x0.
+template <class F, class DF>
+double newton_root(double x, F f, DF df) {
+  for (int it = 0; it < 100; ++it) {
+    const double dx = f(x) / df(x);
+    x -= dx;
+    if (std::abs(dx) < 1e-15 * x) break;
+  }
+  return x;
+}
+}  // namespace
+
+double pinned_free_beta_l(int k) {  // sin x cosh x − cos x sinh x = 0 (÷ cosh x: no overflow)
+  return newton_root((4 * k + 1) * M_PI / 4, [](double x) { return std::sin(x) - std::cos(x) * std::tanh(x); },
+                     [](double x) { const double h = 1 / std::cosh(x); return std::cos(x) + std::sin(x) * std::tanh(x) - std::cos(x) * h * h; });
+}
+
+double free_free_beta_l(int k) {  // cos x − 1/cosh x = 0
+  return newton_root((2 * k + 1) * M_PI / 2, [](double x) { return std::cos(x) - 1 / std::cosh(x); },
+                     [](double x) { return -std::sin(x) + std::tanh(x) / std::cosh(x); });
+}
+
 double cantilever_tip_mass_beta_l(double mu, double eta, int k) {
   auto f = [&](double x) {  // the frequency equation divided by cosh x (no overflow)
     const double c = std::cos(x), s = std::sin(x), h = 1.0 / std::cosh(x), t = std::tanh(x);
@@ -52,6 +75,7 @@ double cantilever_omega(const Segment& s, ModeKind kind, int k) {
       const double b = cantilever_beta_l(k) / L;
       return b * b * std::sqrt(E * c.Iy / (rho * c.A));
     }
+    case ModeKind::Rigid: return 0.0;  // a clamped cantilever has none
   }
   return 0.0;
 }

@@ -8,6 +8,12 @@ namespace rfem::beam {
 
 /// k-th root (k ≥ 1) of 1 + cos x cosh x = 0: 1.875104, 4.694091, 7.854757, …
 double cantilever_beta_l(int k);
+/// k-th elastic root (k ≥ 1) of tan x = tanh x: βL of a pinned–free beam (and of clamped–pinned),
+/// 3.926602, 7.068583, 10.210176, …
+double pinned_free_beta_l(int k);
+/// k-th elastic root (k ≥ 1) of cos x cosh x = 1: βL of a free–free beam (and of clamped–clamped),
+/// 4.730041, 7.853205, 10.995608, …
+double free_free_beta_l(int k);
 /// k-th root λ = βL of the Euler–Bernoulli cantilever carrying at its free end a mass μ·ρAL with
 /// rotary inertia η·ρAL³ about the tip:
 ///   1 + cos λ cosh λ + λμ(cos λ sinh λ − sin λ cosh λ) − λ³η(sin λ cosh λ + cos λ sinh λ)

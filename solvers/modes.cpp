@@ -1,6 +1,10 @@
 #include "solvers/modes.hpp"
 
 #include <Spectra/SymEigsShiftSolver.h>
+#include <Spectra/SymGEigsShiftSolver.h>
+
+#include <algorithm>
+#include <set>
 
 #include <stdexcept>
 
@@ -17,6 +21,7 @@ std::string to_string(ModeKind k) {
     case ModeKind::BendingY: return "bending-y";
     case ModeKind::BendingZ: return "bending-z";
     case ModeKind::Torsion: return "torsion";
+    case ModeKind::Rigid: return "rigid";
   }
   return "?";
 }
@@ -78,6 +83,51 @@ class ShiftInvertOp {
   CholmodSolver solver_;
 };
 
+// With free joints M is bordered, not block diagonal: the generalised problem K φ = λ M φ in
+// Spectra's shift-invert mode, (K − σM)⁻¹ by CHOLMOD and M x on the pattern.
+class GeneralShiftInvertOp {
+ public:
+  using Scalar = double;
+  GeneralShiftInvertOp(const BorderedPattern& p, const std::vector<double>& K, const std::vector<double>& M)
+      : pattern_(p), K_(K), M_(M), solver_(p) {}
+  Eigen::Index rows() const { return pattern_.size(); }
+  Eigen::Index cols() const { return pattern_.size(); }
+  void set_shift(double sigma) {
+    std::vector<double> S = K_;
+    for (size_t i = 0; i < S.size(); ++i) S[i] -= sigma * M_[i];
+    if (!solver_.factorize(S))
+      throw std::runtime_error("modal analysis: K − σM is not positive definite (is the link buckled?)");
+  }
+  void perform_op(const double* x, double* y) const {
+    VecX b = Eigen::Map<const VecX>(x, rows());
+    solver_.solve(b);
+    Eigen::Map<VecX>(y, rows()) = b;
+  }
+
+ private:
+  const BorderedPattern& pattern_;
+  const std::vector<double>& K_;
+  const std::vector<double>& M_;
+  CholmodSolver solver_;
+};
+
+class MassProductOp {
+ public:
+  using Scalar = double;
+  MassProductOp(const BorderedPattern& p, const std::vector<double>& M) : pattern_(p), M_(M) {}
+  Eigen::Index rows() const { return pattern_.size(); }
+  Eigen::Index cols() const { return pattern_.size(); }
+  void perform_op(const double* x, double* y) const {
+    VecX out;
+    pattern_.multiply(M_, Eigen::Map<const VecX>(x, rows()), out);
+    Eigen::Map<VecX>(y, rows()) = out;
+  }
+
+ private:
+  const BorderedPattern& pattern_;
+  const std::vector<double>& M_;
+};
+
 ModeKind classify(const VecX& phi, const BlockMass& bm) {
   double w[4] = {0, 0, 0, 0};  // axial, bending-y (x2, φ3), bending-z (x3, φ2), torsion (φ1)
   static const int kind_of[6] = {0, 1, 2, 3, 2, 1};
@@ -91,30 +141,88 @@ ModeKind classify(const VecX& phi, const BlockMass& bm) {
 
 }  // namespace
 
-ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, int count, int dense_limit) {
-  const int n = model.n(), N = 6 * n;
+ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, int count, int dense_limit,
+                          const std::vector<int>& free) {
+  const int n = model.n(), nf = static_cast<int>(free.size()), N = 6 * n + nf;
   if (n == 0) throw std::invalid_argument("modal analysis needs a flexible link (n ≥ 1)");
-  if (count < 1 || count > N) throw std::invalid_argument("mode count must be between 1 and 6n = " + std::to_string(N));
+  if (std::set<int>(free.begin(), free.end()).size() != free.size())
+    throw std::invalid_argument("a joint is freed twice");
+  for (int j : free)
+    if (j < 0 || j >= model.m())
+      throw std::invalid_argument("no joint " + std::to_string(j + 1) + " to free (the model has " + std::to_string(model.m()) + ")");
+  if (count < 1 || count > N)
+    throw std::invalid_argument("mode count must be between 1 and 6n + free joints = " + std::to_string(N));
   ModesResult res;
   res.q0 = solve_static(model, qb, vb, TipLoads{}).q;
   VecX v = VecX::Zero(model.dof());
   v.tail(model.m()) = vb;
-  const BorderedPattern pattern(n, 0);
+  std::vector<int> cols(model.m(), -1);
+  for (int i = 0; i < nf; ++i) cols[free[i]] = 6 * n + i;
+  if (nf > 0) {  // a free joint must be in equilibrium where the held ones are
+    VecX F;
+    generalised_forces(model, res.q0, v, VecX::Zero(model.dof()), ForceTerms{}, F);
+    const VecX tau = F.tail(model.m());
+    const double scale = std::max(1.0, tau.cwiseAbs().maxCoeff());
+    for (int j : free)
+      if (std::abs(tau[j]) > 1e-9 * scale)
+        throw std::invalid_argument("joint " + std::to_string(j + 1) + " (" + model.joints[j].name + ") carries " +
+                                    std::to_string(tau[j]) + (model.joints[j].type == JointType::Revolute ? " N m" : " N") + " in the held equilibrium: freed, it has no "
+                                    "equilibrium to linearise about");
+  }
+  const BorderedPattern pattern(n, nf);
   MatrixTerms terms;
   terms.stiffness = 1.0;
   terms.gravity = true;
   terms.inertial = vb.size() > 0 && vb.norm() > 0.0;
-  std::vector<double> K;
-  assemble_matrix(model, pattern, std::vector<int>(model.m(), -1), res.q0, v, terms, K);
+  std::vector<double> K, Mv;
+  assemble_matrix(model, pattern, cols, res.q0, v, terms, K);
   const BlockMass bm = block_mass(model, res.q0);
+  if (nf > 0) {
+    MatrixTerms mt;
+    mt.mass = 1.0;
+    assemble_matrix(model, pattern, cols, res.q0, v, mt, Mv);
+  }
   VecX lambda;
   if (N <= dense_limit) {
     MatX Md = MatX::Zero(N, N);
-    for (int k = 0; k < n; ++k) Md.block<6, 6>(6 * k, 6 * k) = bm.M[k];
+    if (nf > 0) Md = to_dense(pattern, Mv);
+    else
+      for (int k = 0; k < n; ++k) Md.block<6, 6>(6 * k, 6 * k) = bm.M[k];
     Eigen::GeneralizedSelfAdjointEigenSolver<MatX> es(to_dense(pattern, K), Md);
     if (es.info() != Eigen::Success) throw std::runtime_error("modal analysis: dense eigen-solver failed");
     lambda = es.eigenvalues().head(count);
     res.shapes = es.eigenvectors().leftCols(count);
+  } else if (nf > 0) {
+    res.dense = false;
+    // Rigid-body modes sit at λ = 0, where K − σM is singular: shift below zero, then once more
+    // further down for the uncertainty estimate (as below).
+    const double scale = 1e-3 * std::abs(K[pattern.diag(n - 1)] / Mv[pattern.diag(n - 1)]);
+    auto lanczos = [&](double sigma, VecX& lam, MatX& shapes) {
+      GeneralShiftInvertOp op(pattern, K, Mv);
+      MassProductOp bop(pattern, Mv);
+      const int ncv = std::min(N, std::max(2 * count + 1, count + 20));
+      Spectra::SymGEigsShiftSolver<GeneralShiftInvertOp, MassProductOp, Spectra::GEigsMode::ShiftInvert> eigs(
+          op, bop, count, ncv, sigma);
+      eigs.init();
+      eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
+      if (eigs.info() != Spectra::CompInfo::Successful) throw std::runtime_error("modal analysis: Lanczos did not converge");
+      const VecX ev = eigs.eigenvalues();
+      const MatX U = eigs.eigenvectors();
+      lam.resize(count);
+      shapes.resize(N, count);
+      for (int i = 0; i < count; ++i) {
+        lam[i] = ev[count - 1 - i];
+        shapes.col(i) = U.col(count - 1 - i);
+      }
+    };
+    lanczos(-1e-6 * scale, lambda, res.shapes);
+    VecX check;
+    MatX check_shapes;
+    double first_elastic = lambda[count - 1];  // (as σ = −λ₁ below, on the first non-rigid mode)
+    for (int i = count - 1; i >= 0; --i)
+      if (lambda[i] > 1e-9 * scale) first_elastic = lambda[i];
+    lanczos(-1e-6 * scale - std::max(std::abs(first_elastic), 1e-12), check, check_shapes);
+    res.uncertainty = ((check - lambda).cwiseAbs().array() / lambda.cwiseAbs().array().max(1e-300)).matrix();
   } else {
     res.dense = false;
     // Shift-invert Lanczos at σ = 0, then once more at σ = −λ₁: the factorisations of K − σM
@@ -147,8 +255,20 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
     res.uncertainty = ((check - lambda).cwiseAbs().array() / lambda.cwiseAbs().array().max(1e-300)).matrix();
   }
   if (res.uncertainty.size() == 0) res.uncertainty = VecX::Zero(count);
+  // Rigid-body modes: ω² at the round-off of a zero eigenvalue of the stiffest coordinate.
+  double stiffest = 0.0;
+  for (int k = 0; k < n; ++k)
+    for (int i = 0; i < 6; ++i)
+      stiffest = std::max(stiffest, K[pattern.slot(6 * k + i, 6 * k + i)] / bm.M[k](i, i));
   res.omega = lambda.cwiseMax(0.0).cwiseSqrt();
-  for (int i = 0; i < count; ++i) res.kind.push_back(classify(res.shapes.col(i), bm));
+  for (int i = 0; i < count; ++i) {
+    const bool rigid = nf > 0 && std::abs(lambda[i]) <= kRigidModeFraction * stiffest;
+    if (rigid) {
+      res.omega[i] = 0.0;
+      res.uncertainty[i] = 0.0;
+    }
+    res.kind.push_back(rigid ? ModeKind::Rigid : classify(res.shapes.col(i), bm));
+  }
   return res;
 }
 

@@ -1,21 +1,22 @@
 #pragma once
-// Linearised modal analysis of the flexible link with the base held: about the static equilibrium
-// under gravity, or in a frame rotating with steady joint rates (centrifugal softening and the
-// geometric stiffening of the sdes included; gyroscopic coupling neglected, so the problem stays
-// symmetric: K φ = ω² M_ff φ). Dense for small systems, shift-invert Lanczos (Spectra) on the
-// CHOLMOD factor for large ones.
+// Linearised modal analysis of the flexible link with the base held, or with chosen joints free:
+// about the static equilibrium under gravity, or in a frame rotating with steady joint rates
+// (centrifugal softening and the geometric stiffening of the sdes included; gyroscopic coupling
+// neglected, so the problem stays symmetric: K φ = ω² M φ over the rfe coordinates and the free
+// joints). Dense for small systems, shift-invert Lanczos (Spectra) on the CHOLMOD factor for large
+// ones. Free joints without stiffness give rigid-body modes (ω = 0, kind Rigid).
 #include <string>
 
 #include "core/model.hpp"
 
 namespace rfem {
 
-enum class ModeKind { Axial, BendingY, BendingZ, Torsion };
+enum class ModeKind { Axial, BendingY, BendingZ, Torsion, Rigid };
 std::string to_string(ModeKind k);
 
 struct ModesResult {
   VecX omega;             ///< natural circular frequencies [rad/s], ascending
-  MatX shapes;            ///< flexible coordinates of each mode (6n × count), M-normalised
+  MatX shapes;            ///< rfe coordinates, then the free joints', of each mode ((6n + f) × count), M-normalised
   std::vector<ModeKind> kind;  ///< dominant motion (BendingY: deflection along y)
   VecX q0;                ///< the equilibrium linearised about
   bool dense = true;      ///< which eigen-solver ran
@@ -29,8 +30,14 @@ struct ModesResult {
 constexpr double kUncertaintyTolerance = 1e-8;
 
 /// Lowest `count` modes. `vb` are the steady joint rates (empty or zero: no rotation).
-/// `dense_limit`: largest 6n solved densely.
+/// `free`: joints (0-based) that move with the modes instead of being held; each must carry no
+/// torque in the held equilibrium (else there is no equilibrium to linearise about).
+/// `dense_limit`: largest 6n + f solved densely. Throws std::invalid_argument for bad arguments.
 ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, int count,
-                          int dense_limit = 600);
+                          int dense_limit = 600, const std::vector<int>& free = {});
+
+/// A mode is rigid when ω² is below this fraction of the stiffest coordinate's K_ii / M_ii (the
+/// round-off level of a zero eigenvalue).
+constexpr double kRigidModeFraction = 1e-12;
 
 }  // namespace rfem

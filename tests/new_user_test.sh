@@ -47,6 +47,10 @@ expect_2 "a directory as the case" run "$src/cases"
 expect_2 "refine with repeated n" refine "$src/cases/kane_spinup.toml" --n 10,10,20 --quantity peak:u1
 expect_2 "refine beyond t_end" refine "$src/cases/kane_spinup.toml" --n 10,20,40 --quantity u1@30
 expect_2 "refine without a quantity" refine "$src/cases/kane_spinup.toml" --n 10,20
+expect_2 "modes --free of an unknown joint" modes "$src/cases/kane_spinup.toml" --free elbow
+expect_2 "modes --free base without a free base" modes "$src/cases/kane_spinup.toml" --free base
+expect_2 "modes --free of a joint under a static torque" modes "$src/cases/kane_spinup.toml" --free hub \
+  --set joints.0.alpha=1.5707963267948966 --set gravity.g=9.81
 grep -q "directory" <("$rfem" run "$src/cases" 2>&1) && ok "directory named as such" || bad "directory message"
 "$rfem" run "$src/cases/kane_spinup.toml" --set simulation.t_end=0.1 -q -o t1.h5 --threads 1 \
   && ok "global option after the command" || bad "--threads after the command"

@@ -200,3 +200,95 @@ TEST(RotatingBeam, StaticStretchOfASpinningBar) {
   EXPECT_NEAR(p, 2.0, 0.3);
   EXPECT_NEAR(rich, exact, 1e-4 * exact) << "n = 40: " << u[2];
 }
+
+TEST(FreeJoints, BeamOnAFreeHubHasThePinnedFreeFrequencies) {
+  // Kane's beam on its hub (vertical axis through the root, no hub inertia) with the hub free:
+  // one rigid mode at ω = 0; the horizontal-plane bending becomes pinned–free (tan βL = tanh βL)
+  // and converges at least with order 2 to within the Timoshenko bound of it (measured: order
+  // 3.5–3.7, the limit 1.6e-4 below Euler–Bernoulli — with no clamped end the 1/n² term of the
+  // cantilever nearly vanishes); the vertical-plane bending does not couple to the hub and keeps
+  // the cantilever's frequencies to the dense solver's round-off, 100 ε (ω_max/ω)².
+  const Case c = read_case(test::source_path("cases/kane_spinup.toml"));
+  const Segment& seg = c.link.segments[0];
+  const double unit = std::sqrt(seg.material.E * seg.section.Iz / (seg.material.rho * seg.section.A)) / (seg.length * seg.length);
+  std::vector<Series> pinned(3);
+  for (int n : {20, 40, 80}) {
+    const Model m = build_model(c, n);
+    const VecX qb = c.joint_values, vb = c.joint_rates;
+    const ModesResult held = compute_modes(m, qb, vb, 6 * n);
+    const ModesResult free = compute_modes(m, qb, vb, 7, 600, {0});
+    const double wmax = held.omega.maxCoeff();
+    ASSERT_EQ(free.kind[0], ModeKind::Rigid);
+    EXPECT_EQ(free.omega[0], 0.0);
+    int ky = 0, kz = 0;
+    for (int i = 1; i < 7; ++i) {
+      if (free.kind[i] == ModeKind::BendingY && ky < 3) pinned[ky++].v.push_back(free.omega[i]);
+      if (free.kind[i] == ModeKind::BendingZ) {
+        int seen = 0;  // the held run's kz-th bending-z mode
+        for (int j = 0; j < 6; ++j)
+          if (held.kind[j] == ModeKind::BendingZ && seen++ == kz) {
+            EXPECT_NEAR(free.omega[i] / held.omega[j], 1.0, 100 * 2.2e-16 * std::pow(wmax / held.omega[j], 2));
+          }
+        ++kz;
+      }
+    }
+    ASSERT_EQ(ky, 3) << "n = " << n;
+  }
+  for (int k = 1; k <= 3; ++k) {
+    const double exact = std::pow(beam::pinned_free_beta_l(k), 2) * unit;
+    EXPECT_GT(pinned[k - 1].order(), 1.85) << "pinned-free mode " << k;
+    RecordProperty("pinned_free_order_" + std::to_string(k), std::to_string(pinned[k - 1].order()));
+    EXPECT_LT(std::abs(pinned[k - 1].richardson() / exact - 1.0), timoshenko_bound(seg, beam::pinned_free_beta_l(k), seg.section.Iz))
+        << "pinned-free mode " << k;
+  }
+  EXPECT_NEAR(beam::pinned_free_beta_l(1), 3.926602, 1e-6);
+  EXPECT_NEAR(beam::pinned_free_beta_l(2), 7.068583, 1e-6);
+}
+
+TEST(FreeJoints, BeamOnAWeightlessFreeBaseHasTheFreeFreeFrequencies) {
+  // Kane's beam (Iz = 3e-7) on a free base whose bus weighs 1e-9 of the beam: six rigid modes,
+  // then free–free bending in both planes (cos βL cosh βL = 1), at least order 2 (measured 3.5–3.6,
+  // as the pinned–free beam's) with Richardson within the Timoshenko bound; Lanczos agrees with
+  // the dense solver.
+  const Case c = kane();
+  const Segment& seg = c.link.segments[0];
+  const double mass = seg.material.rho * seg.section.A * seg.length, tiny = 1e-9 * mass;
+  Mat4 H = Mat4::Zero();
+  H.diagonal() << tiny, tiny, tiny, tiny;  // a point-like bus of inertia ~ tiny · 1 m²
+  std::vector<Series> y(2), z(2);
+  for (int n : {20, 40, 80}) {
+    Model m = build_model(c, n);
+    m = make_model(free_base_joints(H), m.mount, m.link, 0.0);
+    m.free_base = true;
+    const std::vector<int> all{0, 1, 2, 3, 4, 5};
+    const VecX qb = VecX::Zero(6), vb = VecX::Zero(6);
+    const ModesResult r = compute_modes(m, qb, vb, 12, 600, all);
+    for (int i = 0; i < 6; ++i) ASSERT_EQ(r.kind[i], ModeKind::Rigid) << "mode " << i + 1 << " at n = " << n;
+    int ky = 0, kz = 0;
+    for (int i = 6; i < 12; ++i) {
+      if (r.kind[i] == ModeKind::BendingY && ky < 2) y[ky++].v.push_back(r.omega[i]);
+      if (r.kind[i] == ModeKind::BendingZ && kz < 2) z[kz++].v.push_back(r.omega[i]);
+    }
+    ASSERT_EQ(ky, 2);
+    ASSERT_EQ(kz, 2);
+    const ModesResult ax = compute_modes(m, qb, vb, 1, 0, all);  // Lanczos: lowest is rigid
+    EXPECT_EQ(ax.kind[0], ModeKind::Rigid);
+    if (n == 40) {
+      const ModesResult lz = compute_modes(m, qb, vb, 12, 0, all);
+      ASSERT_FALSE(lz.dense);
+      // the dense solver's round-off, as in LanczosMatchesDenseEigenSolver: 100 ε (ω_max/ω)²
+      const double wmax = compute_modes(m, qb, vb, 6 * n + 6, 600, all).omega.maxCoeff();
+      for (int i = 6; i < 12; ++i)
+        EXPECT_NEAR(lz.omega[i] / r.omega[i], 1.0, 100 * 2.2e-16 * std::pow(wmax / r.omega[i], 2)) << "mode " << i + 1;
+    }
+  }
+  for (int k = 1; k <= 2; ++k)
+    for (const auto& [s, I] : {std::pair{y[k - 1], seg.section.Iz}, std::pair{z[k - 1], seg.section.Iy}}) {
+      const double bl = beam::free_free_beta_l(k);
+      const double exact = bl * bl / (seg.length * seg.length) * std::sqrt(seg.material.E * I / (seg.material.rho * seg.section.A));
+      EXPECT_GT(s.order(), 1.85) << "free-free mode " << k << " I = " << I;
+      EXPECT_LT(std::abs(s.richardson() / exact - 1.0), timoshenko_bound(seg, bl, I)) << "free-free mode " << k;
+    }
+  EXPECT_NEAR(beam::free_free_beta_l(1), 4.730041, 1e-6);
+  EXPECT_NEAR(beam::free_free_beta_l(2), 7.853205, 1e-6);
+}
