@@ -48,7 +48,7 @@ int run_modes(const Common& c, const ModesOptions& o) {
   VecX qb, vb;
   joint_state(cs, o, qb, vb);
   const std::vector<int> freed = free_joints(cs, model, o.free);
-  const int nf = static_cast<int>(freed.size()), all = 6 * model.n() + nf;
+  const int nf = static_cast<int>(freed.size()), all = model.flexible_dofs() + nf;
   const int count = std::min(o.count, all);
   if (o.count > count && !c.json)
     fmt::print(stderr, "rfem: note: --count {} capped at 6n{} = {} (every mode of n = {} rfes{})\n", o.count,

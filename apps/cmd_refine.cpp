@@ -60,20 +60,20 @@ double evaluate_static(const Case& cs, int n, const StaticQuantity& s, const std
   if (s.what == "tip") return tip_motion(model, solve_static(model, qb, vb, cs.loads).q)[s.index];
   const int k = s.index;
   if (s.what == "mode") {
-    if (k > 6 * model.n())
-      throw CaseError("--quantity " + quantity + ": n = " + std::to_string(n) + " has only " + std::to_string(6 * model.n()) + " modes");
+    if (k > model.flexible_dofs())
+      throw CaseError("--quantity " + quantity + ": n = " + std::to_string(n) + " has only " + std::to_string(model.flexible_dofs()) + " modes");
     return compute_modes(model, qb, vb, k).omega[k - 1] / (2 * M_PI);
   }
   // Modes of one kind can sit high in the spectrum (axial modes of a slender beam): widen the
   // search until the k-th one appears.
-  for (int count = std::min(6 * model.n(), 4 * k + 8);; count = std::min(6 * model.n(), 2 * count)) {
+  for (int count = std::min(model.flexible_dofs(), 4 * k + 8);; count = std::min(model.flexible_dofs(), 2 * count)) {
     const ModesResult r = compute_modes(model, qb, vb, count);
     int seen = 0;
     for (int i = 0; i < count; ++i)
       if (to_string(r.kind[i]) == s.what && ++seen == k) return r.omega[i] / (2 * M_PI);
-    if (count == 6 * model.n()) break;
+    if (count == model.flexible_dofs()) break;
   }
-  throw std::runtime_error("--quantity " + quantity + ": no such mode among all " + std::to_string(6 * model.n()) +
+  throw std::runtime_error("--quantity " + quantity + ": no such mode among all " + std::to_string(model.flexible_dofs()) +
                            " at n = " + std::to_string(n));
 }
 
@@ -158,7 +158,7 @@ std::vector<double> evaluate_dynamic(const Case& cs, const std::vector<JointInpu
       if (!qs[i].dynamic || run != prefix + d.run) continue;
       double x = 0.0;
       if (d.what == "tau") x = s.tau[d.joint - 1];
-      else if (d.what == "q") x = s.q[m.base_index(d.joint - 1)];
+      else if (d.what == "q") x = s.q[m.joint_index(d.joint - 1)];
       else x = tip_deflection(m, s.q)[d.what == "u1" ? 0 : d.what == "u2" ? 1 : 2];
       if (d.time < 0) value[i] = std::max(value[i], std::abs(x));
       else if (std::abs(s.t - d.time) < best_dt[i]) best_dt[i] = std::abs(s.t - d.time), value[i] = x;

@@ -251,7 +251,7 @@ void RunGroup::write_row(const std::string& name, long row, const double* data) 
 
 void RunGroup::append(const OutputSample& s) {
   const int m = model_.m();
-  const VecX qb = s.q.tail(m), vb = s.v.tail(m), ab = s.a.tail(m);
+  const VecX qb = model_.joint_coords(s.q), vb = model_.joint_coords(s.v), ab = model_.joint_coords(s.a);
   write_row("time", rows_, &s.t);
   if (m > 0) {
     write_row("joint_q", rows_, qb.data());

@@ -86,36 +86,36 @@ void generalised_forces(const Model& model, const VecX& q, const VecX& v, const 
   for (int c = 0; c < nchunks; ++c) {
     DeformationTransform dt;
     const int k0 = ws.chunk_begin(c), k1 = ws.chunk_end(c, n);
-    RfeRotation left = k0 > 0 ? rotation_of(rfe_coords(q, k0 - 1)) : clamp_rotation();
+    RfeRotation left = k0 > 0 ? rotation_of(rfe_coords(model, q, k0 - 1)) : clamp_rotation();
     BaseMoments& mom = ws.moments[c];
     const Mat3 R0 = bk.B0.topLeftCorner<3, 3>();
     for (int k = k0; k < k1; ++k) {
       const Rfe& rfe = d.rfes[k];
-      const Vec6 qk = rfe_coords(q, k);
+      const Vec6 qk = rfe_coords(model, q, k);
       deformation_transform(qk, dt, false);
       const Vec3 p = bk.B0.topLeftCorner<3, 3>() * (rfe.centre + qk.head<3>()) + bk.B0.topRightCorner<3, 1>();
       Vec6 f = Vec6::Zero();
       if (terms.inertia) {
         Vec3 fi, ni;
-        rfe_inertia(rfe, bk, dt, rfe_coords(vi, k), rfe_coords(a, k), p, f, fi, ni);
+        rfe_inertia(rfe, bk, dt, rfe_coords(model, vi, k), rfe_coords(model, a, k), p, f, fi, ni);
         mom.f += fi;
         mom.n += ni;
       }
       f.head<3>() += g * rfe.mass * R0.row(2).transpose();  // gravity on the mass centre
       mom.s += rfe.mass * Vec4(p[0], p[1], p[2], 1.0);
-      F.segment<6>(6 * k) = f;
+      F.segment<6>(model.rfe_index(k)) = f;
       const RfeRotation right = rfe_rotation(dt);
       if (terms.sde) {
         const Sde& e = d.sdes[k];
         SdeResult r;
-        sde_forces(e, left_centre(d, e), rfe.centre, beta, left_coords(q, k), left_coords(v, k), qk,
-                   rfe_coords(v, k), left, right, r);
+        sde_forces(e, left_centre(d, e), rfe.centre, beta, left_coords(model, q, k), left_coords(model, v, k), qk,
+                   rfe_coords(model, v, k), left, right, r);
         if (k == k0) {
           if (k > 0) ws.boundary[c] = r.f.head<6>();  // rfe k−1 belongs to the previous chunk
         } else {
-          F.segment<6>(6 * (k - 1)) += r.f.head<6>();
+          F.segment<6>(model.rfe_index(k - 1)) += r.f.head<6>();
         }
-        F.segment<6>(6 * k) += r.f.tail<6>();
+        F.segment<6>(model.rfe_index(k)) += r.f.tail<6>();
         ws.power[c] += r.P_d;
       }
       left = right;
@@ -124,7 +124,7 @@ void generalised_forces(const Model& model, const VecX& q, const VecX& v, const 
   BaseMoments flex;
   double Pd = 0.0;
   for (int c = 0; c < nchunks; ++c) {
-    if (c > 0 && terms.sde) F.segment<6>(6 * (ws.chunk_begin(c) - 1)) += ws.boundary[c];
+    if (c > 0 && terms.sde) F.segment<6>(model.rfe_index(ws.chunk_begin(c) - 1)) += ws.boundary[c];
     flex += ws.moments[c];
     Pd += ws.power[c];
   }
@@ -134,13 +134,13 @@ void generalised_forces(const Model& model, const VecX& q, const VecX& v, const 
     double eps = 0.0;
     if (terms.inertia)  // rigid links through Y; the rfes through their wrench and joint j's unit twist
       eps = trace_prod(X, S[j].Y) + Vec3(X(2, 1), X(0, 2), X(1, 0)).dot(flex.n) + X.topRightCorner<3, 1>().dot(flex.f);
-    F[6 * n + j] = eps + g * (X * S[j].s)[2];
+    F[model.joint_index(j)] = eps + g * (X * S[j].s)[2];
     const JointDrive& dr = model.joints[j].drive;
     if (!dr.active()) continue;
-    const double vj = v[6 * n + j];
-    if (terms.inertia) F[6 * n + j] += dr.inertia * a[6 * n + j];
+    const double vj = v[model.joint_index(j)];
+    if (terms.inertia) F[model.joint_index(j)] += dr.inertia * a[model.joint_index(j)];
     if (terms.sde) {
-      F[6 * n + j] += dr.dissipative_force(vj);
+      F[model.joint_index(j)] += dr.dissipative_force(vj);
       Pd += dr.power(vj);
     }
   }
@@ -186,7 +186,7 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
   ws.boundary_block.assign(static_cast<size_t>(nchunks) * (1 + ne), Mat6::Zero());
   if (base_rows) base_rows->setZero(m, pattern.size());
   std::vector<int> col(m);  // joint → border column (−1 if held)
-  for (int j = 0; j < m; ++j) col[j] = base_col[j] >= 0 ? base_col[j] - 6 * n : -1;
+  for (int j = 0; j < m; ++j) col[j] = base_col[j] >= 0 ? base_col[j] - model.flexible_dofs() : -1;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(n))
   for (int c = 0; c < nchunks; ++c) {
     RfePose pose;
@@ -196,16 +196,16 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
     Mat12 Ke, Ce, A;
     DeformationTransform left;  // the rfe before, for the sde between them
     const int k0 = ws.chunk_begin(c);
-    if (sdes) deformation_transform(k0 > 0 ? rfe_coords(q, k0 - 1) : Vec6::Zero().eval(), left, true);
+    if (sdes) deformation_transform(k0 > 0 ? rfe_coords(model, q, k0 - 1) : Vec6::Zero().eval(), left, true);
     for (int k = k0; k < ws.chunk_end(c, n); ++k) {
       const Rfe& rfe = d.rfes[k];
-      rfe_pose(rfe, bk, rfe_coords(q, k), rfe_coords(v, k), rfe_coords(zero, k), pose, t.inertial, second);
+      rfe_pose(rfe, bk, rfe_coords(model, q, k), rfe_coords(model, v, k), rfe_coords(model, zero, k), pose, t.inertial, second);
       rfe_mass_blocks(rfe, pose, bk, Mkk, border, G);
       ws.moments[c].G += G;
       ws.moments[c].s += pose.W * rfe.H.col(3);
       Mat6 blk = t.mass * Mkk;
       border *= t.mass;
-      if (base_rows) base_rows->middleCols<6>(6 * k) = border;
+      if (base_rows) base_rows->middleCols<6>(model.rfe_index(k)) = border;
       if (t.inertial) blk += t.stiffness * rfe_inertial_stiffness(rfe, pose, bk);
       if (g != 0.0) {
         gb.setZero(m, 6);
@@ -218,7 +218,7 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
           for (int l = 0; l < 6; ++l) values[pattern.border(k) + static_cast<long>(l) * nb + col[j]] = border(j, l);
       if (!sdes) continue;
       const Sde& e = d.sdes[k];
-      sde_matrices(e, left_centre(d, e), rfe.centre, d.damping_beta, left_coords(q, k), rfe_coords(q, k), left, pose.d,
+      sde_matrices(e, left_centre(d, e), rfe.centre, d.damping_beta, left_coords(model, q, k), rfe_coords(model, q, k), left, pose.d,
                    Ke, damping ? &Ce : nullptr);
       const bool first = k == k0 && k > 0;  // its left rfe belongs to the previous chunk
       const size_t bslot = static_cast<size_t>(c) * (1 + ne);
@@ -253,7 +253,7 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
       if (col[j] < 0 || l < j) continue;
       double val = mass;
       if (g != 0.0) val += t.stiffness * g * (bk.Xi[j] * bk.Xi[l] * S[hi].s)[2];
-      if (j == l && t.damping != 0.0) val += t.damping * model.joints[j].drive.damping_derivative(v[6 * n + j]);
+      if (j == l && t.damping != 0.0) val += t.damping * model.joints[j].drive.damping_derivative(v[model.joint_index(j)]);
       values[pattern.base() + static_cast<long>(std::min(col[j], col[l])) * nb + std::max(col[j], col[l])] += val;
     }
 }
@@ -276,7 +276,7 @@ Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* w
     const Mat4& H = model.joints[i].H;
     E.kinetic += 0.5 * trace_prod(bk.Wd[i] * H, bk.Wd[i].transpose());
     E.gravity += model.gravity * (bk.W[i] * H.col(3))[2];
-    const double vi = v[6 * n + i];
+    const double vi = v[model.joint_index(i)];
     E.kinetic += model.joints[i].drive.kinetic_energy(vi);
     E.dissipation_rate += model.joints[i].drive.power(vi);
   }
@@ -286,12 +286,12 @@ Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* w
   for (int c = 0; c < nchunks; ++c) {
     RfePose pose;
     for (int k = ws.chunk_begin(c); k < ws.chunk_end(c, n); ++k) {
-      rfe_pose(d.rfes[k], bk, rfe_coords(q, k), rfe_coords(v, k), rfe_coords(ws.zero, k), pose, false);
+      rfe_pose(d.rfes[k], bk, rfe_coords(model, q, k), rfe_coords(model, v, k), rfe_coords(model, ws.zero, k), pose, false);
       const Sde& s = d.sdes[k];
       SdeResult r;
-      sde_forces(s, left_centre(d, s), d.rfes[k].centre, d.damping_beta, left_coords(q, k), left_coords(v, k),
-                 rfe_coords(q, k), rfe_coords(v, k), r);
-      part[c] += Eigen::Vector4d(rfe_kinetic_energy(d.rfes[k], pose, bk, rfe_coords(v, k)),
+      sde_forces(s, left_centre(d, s), d.rfes[k].centre, d.damping_beta, left_coords(model, q, k), left_coords(model, v, k),
+                 rfe_coords(model, q, k), rfe_coords(model, v, k), r);
+      part[c] += Eigen::Vector4d(rfe_kinetic_energy(d.rfes[k], pose, bk, rfe_coords(model, v, k)),
                                  model.gravity * (pose.W * d.rfes[k].H.col(3))[2], r.V, r.P_d);
     }
   }

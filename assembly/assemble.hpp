@@ -61,10 +61,12 @@ struct Energies {
 Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* ws = nullptr);
 
 /// Views of one rfe's coordinates in a full coordinate vector.
-inline Vec6 rfe_coords(const VecX& x, int k) { return x.segment<6>(6 * k); }
+inline Vec6 rfe_coords(const Model& model, const VecX& x, int k) { return x.segment<6>(model.rfe_index(k)); }
 /// Coordinates of the rfe left of sde e (zeros for rfe_0, which is rigid with {r}).
-inline Vec6 left_coords(const VecX& x, int e) { return e > 0 ? rfe_coords(x, e - 1) : Vec6::Zero().eval(); }
+inline Vec6 left_coords(const Model& model, const VecX& x, int e) {
+  return e > 0 ? rfe_coords(model, x, e - 1) : Vec6::Zero().eval();
+}
 /// The base part of a full coordinate vector.
-inline VecX base_coords(const Model& model, const VecX& x) { return x.tail(model.m()); }
+inline VecX base_coords(const Model& model, const VecX& x) { return model.joint_coords(x); }
 
 }  // namespace rfem

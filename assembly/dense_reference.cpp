@@ -31,17 +31,17 @@ std::vector<Body> bodies(const Model& model, const VecX& q, bool second) {
     b.W = bk.W[i];
     b.H = model.joints[i].H;
     for (int j = 0; j <= i; ++j) {
-      b.dW[6 * n + j] = bk.Xi[j] * b.W;
+      b.dW[model.joint_index(j)] = bk.Xi[j] * b.W;
       if (second)
         for (int l = 0; l <= i; ++l)
-          b.ddW[6 * n + j][6 * n + l] = bk.Xi[std::min(j, l)] * bk.Xi[std::max(j, l)] * b.W;
+          b.ddW[model.joint_index(j)][model.joint_index(l)] = bk.Xi[std::min(j, l)] * bk.Xi[std::max(j, l)] * b.W;
     }
     out.push_back(std::move(b));
   }
   for (int k = 0; k < n; ++k) {
     const Rfe& rfe = model.link.rfes[k];
     DeformationTransform d;
-    deformation_transform(q.segment<6>(6 * k), d);
+    deformation_transform(q.segment<6>(model.rfe_index(k)), d);
     Mat4 P = d.D;
     P.topRightCorner<3, 1>() += rfe.centre;
     Body b;
@@ -53,20 +53,20 @@ std::vector<Body> bodies(const Model& model, const VecX& q, bool second) {
       X.topRows<3>() = A;
       return X;
     };
-    for (int l = 0; l < 6; ++l) b.dW[6 * k + l] = bk.B0 * pad(d.dD[l]);
-    for (int j = 0; j < m; ++j) b.dW[6 * n + j] = bk.Xi[j] * b.W;
+    for (int l = 0; l < 6; ++l) b.dW[model.rfe_index(k) + l] = bk.B0 * pad(d.dD[l]);
+    for (int j = 0; j < m; ++j) b.dW[model.joint_index(j)] = bk.Xi[j] * b.W;
     if (second) {
       for (int j = 0; j < m; ++j) {
         for (int l = 0; l < m; ++l)
-          b.ddW[6 * n + j][6 * n + l] = bk.Xi[std::min(j, l)] * bk.Xi[std::max(j, l)] * b.W;
+          b.ddW[model.joint_index(j)][model.joint_index(l)] = bk.Xi[std::min(j, l)] * bk.Xi[std::max(j, l)] * b.W;
         for (int l = 0; l < 6; ++l)
-          b.ddW[6 * n + j][6 * k + l] = b.ddW[6 * k + l][6 * n + j] = bk.Xi[j] * b.dW[6 * k + l];
+          b.ddW[model.joint_index(j)][model.rfe_index(k) + l] = b.ddW[model.rfe_index(k) + l][model.joint_index(j)] = bk.Xi[j] * b.dW[model.rfe_index(k) + l];
       }
       for (int a = 0; a < 3; ++a)
         for (int c = 0; c < 3; ++c) {
           Mat34 A = Mat34::Zero();
           A.leftCols<3>() = d.ddR[a][c];
-          b.ddW[6 * k + 3 + a][6 * k + 3 + c] = bk.B0 * pad(A);
+          b.ddW[model.rfe_index(k) + 3 + a][model.rfe_index(k) + 3 + c] = bk.B0 * pad(A);
         }
     }
     out.push_back(std::move(b));
@@ -82,7 +82,7 @@ MatX dense_mass_matrix(const Model& model, const VecX& q) {
   for (const Body& b : bodies(model, q, false))
     for (int i = 0; i < N; ++i)
       for (int j = 0; j < N; ++j) M(i, j) += (b.dW[i] * b.H * b.dW[j].transpose()).trace();
-  for (int j = 0; j < model.m(); ++j) M(model.base_index(j), model.base_index(j)) += model.joints[j].drive.inertia;
+  for (int j = 0; j < model.m(); ++j) M(model.joint_index(j), model.joint_index(j)) += model.joints[j].drive.inertia;
   return M;
 }
 
@@ -97,11 +97,11 @@ MatX dense_stiffness(const Model& model, const VecX& q, bool gravity) {
     const Sde& s = model.link.sdes[e];
     Mat12 S = Mat12::Zero();
     const Vec3 cl = e > 0 ? model.link.rfes[e - 1].centre : model.link.rfe0.centre;
-    const Vec6 ql = left_coords(q, e);
-    sde_matrix(s, cl, model.link.rfes[e].centre, 0.0, ql, q.segment<6>(6 * e), 1.0, 0.0, S);
+    const Vec6 ql = left_coords(model, q, e);
+    sde_matrix(s, cl, model.link.rfes[e].centre, 0.0, ql, q.segment<6>(model.rfe_index(e)), 1.0, 0.0, S);
     for (int a = 0; a < 12; ++a)
       for (int b = 0; b < 12; ++b) {
-        const int ra = 6 * (e - 1) + a, rb = 6 * (e - 1) + b;
+        const int ra = model.rfe_index(e - 1) + a, rb = model.rfe_index(e - 1) + b;
         if (ra >= 0 && rb >= 0) K(ra, rb) += S(a, b);
       }
   }
@@ -114,17 +114,17 @@ MatX dense_damping(const Model& model, const VecX& q, const VecX& v) {
   for (int e = 0; e < n; ++e) {
     Mat12 S = Mat12::Zero();
     const Vec3 cl = e > 0 ? model.link.rfes[e - 1].centre : model.link.rfe0.centre;
-    const Vec6 ql = left_coords(q, e);
+    const Vec6 ql = left_coords(model, q, e);
     sde_matrix(model.link.sdes[e], cl, model.link.rfes[e].centre, model.link.damping_beta, ql,
-               q.segment<6>(6 * e), 0.0, 1.0, S);
+               q.segment<6>(model.rfe_index(e)), 0.0, 1.0, S);
     for (int a = 0; a < 12; ++a)
       for (int b = 0; b < 12; ++b) {
-        const int ra = 6 * (e - 1) + a, rb = 6 * (e - 1) + b;
+        const int ra = model.rfe_index(e - 1) + a, rb = model.rfe_index(e - 1) + b;
         if (ra >= 0 && rb >= 0) C(ra, rb) += S(a, b);
       }
   }
   for (int j = 0; j < model.m(); ++j)
-    C(model.base_index(j), model.base_index(j)) += model.joints[j].drive.damping_derivative(v[model.base_index(j)]);
+    C(model.joint_index(j), model.joint_index(j)) += model.joints[j].drive.damping_derivative(v[model.joint_index(j)]);
   return C;
 }
 

@@ -35,8 +35,8 @@ Momentum momentum(const Model& model, const VecX& q, const VecX& v, Workspace* w
     Vec3 l;
     Mat3 a;
     for (int k = ws.chunk_begin(c); k < ws.chunk_end(c, n); ++k) {
-      rfe_pose(d.rfes[k], bk, rfe_coords(q, k), rfe_coords(v, k), rfe_coords(ws.zero, k), pose, false);
-      rfe_momentum_moments(d.rfes[k], pose, bk, rfe_coords(v, k), l, a);
+      rfe_pose(d.rfes[k], bk, rfe_coords(model, q, k), rfe_coords(model, v, k), rfe_coords(model, ws.zero, k), pose, false);
+      rfe_momentum_moments(d.rfes[k], pose, bk, rfe_coords(model, v, k), l, a);
       part[c].leftCols<3>() += a;
       part[c].col(3) += l;
     }

@@ -27,12 +27,12 @@ struct Setup {
     const int N = model.dof();
     q = v = a = VecX::Zero(N);
     for (int i = 0; i < N; ++i) {
-      const bool base = i >= 6 * n;
+      const bool base = i >= model.flexible_dofs();
       q[i] = (base ? 1.0 : 1e-3) * u(gen);
       v[i] = (base ? 0.3 : 1e-2) * u(gen);
       a[i] = u(gen);
     }
-    for (int j = 0; j < model.m(); ++j) base_col.push_back(6 * n + j);  // force input: all joints free
+    for (int j = 0; j < model.m(); ++j) base_col.push_back(model.joint_index(j));  // force input: all joints free
   }
 };
 

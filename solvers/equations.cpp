@@ -29,14 +29,14 @@ EquationsOfMotion::EquationsOfMotion(const Model& model, const std::vector<Joint
   ws_.parallel = parallel;
   ws_.parallel.threads = governor_.threads();
   if (static_cast<int>(inputs.size()) != model.m()) throw std::invalid_argument("one input per joint is required");
-  const int n6 = 6 * model.n();
+  const int n6 = model.flexible_dofs();
   for (int i = 0; i < n6; ++i) unknown_.push_back(i);
   base_col_.assign(model.m(), -1);
   int nb = 0;
   for (int j = 0; j < model.m(); ++j)
     if (!inputs[j].prescribed()) {
       base_col_[j] = static_cast<int>(unknown_.size());
-      unknown_.push_back(model.base_index(j));
+      unknown_.push_back(model.joint_index(j));
       ++nb;
     }
   newton_ = std::make_unique<NewtonSystem>(model, base_col_, nb, solver, &ws_, keep_stiffness);
@@ -64,7 +64,7 @@ void EquationsOfMotion::expand(double t, const double* qu, const double* vu, con
   for (int j = 0; j < model_.m(); ++j)
     if (inputs_[j].prescribed()) {
       const MotionSample s = inputs_[j].motion->at(t);
-      const int k = model_.base_index(j);
+      const int k = model_.joint_index(j);
       q_[k] = s.q;
       v_[k] = s.qd;
       a_[k] = s.qdd;
@@ -74,8 +74,8 @@ void EquationsOfMotion::expand(double t, const double* qu, const double* vu, con
 VecX EquationsOfMotion::torques(double t) const {
   VecX tau(model_.m());
   for (int j = 0; j < model_.m(); ++j)
-    tau[j] = inputs_[j].prescribed() ? F_[model_.base_index(j)]
-                                     : inputs_[j].torque->at(t, q_[model_.base_index(j)], v_[model_.base_index(j)]);
+    tau[j] = inputs_[j].prescribed() ? F_[model_.joint_index(j)]
+                                     : inputs_[j].torque->at(t, q_[model_.joint_index(j)], v_[model_.joint_index(j)]);
   return tau;
 }
 
@@ -93,7 +93,7 @@ Power EquationsOfMotion::residual(double t, const double* qu, const double* vu, 
   for (int i = 0; i < u; ++i) r[i] = F_[unknown_[i]];
   for (int j = 0; j < m; ++j)
     if (base_col_[j] >= 0) r[base_col_[j]] -= tau[j];
-  p.input = tau.dot(v_.tail(m));
+  p.input = tau.dot(model_.joint_coords(v_));
   return p;
 }
 
@@ -105,7 +105,7 @@ Power EquationsOfMotion::power_change(double t, const double* vu, const VecX& da
     else {  // P = τ(t, q, v) v with δv = hγ δa, δq = (hγ)² δa
       const TorqueLaw& law = *inputs_[j].torque;
       const double vj = vu[base_col_[j]], dq = hg * hg * da[base_col_[j]], dv = hg * da[base_col_[j]];
-      d.input += law.at(t, q_[model_.base_index(j)], vj) * dv - (law.stiffness() * dq + law.damping() * dv) * vj;
+      d.input += law.at(t, q_[model_.joint_index(j)], vj) * dv - (law.stiffness() * dq + law.damping() * dv) * vj;
     }
   }
   if (model_.link.damping_beta > 0) {  // the Newton system keeps the sdes' C only then
@@ -136,7 +136,7 @@ OutputSample EquationsOfMotion::sample(double t, const double* qu, const double*
   VecX r(unknowns());
   residual(t, qu, vu, a.data(), r.data());  // F at these accelerations: the required torques
   if (model_.free_base) {
-    const double pitch = q_[model_.base_index(free_base_pitch)];
+    const double pitch = q_[model_.joint_index(free_base_pitch)];
     if (std::abs(pitch) > free_base_pitch_limit) {
       char buf[200];
       std::snprintf(buf, sizeof buf,
@@ -196,7 +196,7 @@ void EquationsOfMotion::initial_state(VecX& qu, VecX& vu, bool static_equilibriu
     vb[j] = law ? inputs_[j].motion->at(0.0).qd : inputs_[j].v0;
   }
   const StaticResult eq = solve_static(model_, qb, vb, TipLoads{});
-  qu.head(6 * model_.n()) = eq.q.head(6 * model_.n());
+  qu.head(model_.flexible_dofs()) = eq.q.head(model_.flexible_dofs());
 }
 
 }  // namespace rfem

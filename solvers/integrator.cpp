@@ -14,10 +14,9 @@ namespace {
 RunOutcome inverse_dynamics_only(EquationsOfMotion& eq, const IntegratorOptions& opts, const SampleSink& sink) {
   RunOutcome out;
   const long n_out = std::lround(std::ceil(opts.t_end / opts.output_dt - 1e-9));
-  const int m = eq.model().m();
   auto power = [&](double t) {
     const OutputSample s = eq.sample(t, nullptr, nullptr, nullptr, 0.0, 0.0);
-    return s.tau.dot(s.v.tail(m));
+    return s.tau.dot(eq.model().joint_coords(s.v));
   };
   double W = 0.0, last_t = 0.0, last_P = 0.0;
   for (long k = 0; k <= n_out; ++k) {
@@ -28,7 +27,7 @@ RunOutcome inverse_dynamics_only(EquationsOfMotion& eq, const IntegratorOptions&
     }
     const double Pm = k > 0 ? power(0.5 * (t + last_t)) : 0.0;
     OutputSample s = eq.sample(t, nullptr, nullptr, nullptr, 0.0, 0.0);
-    const double P = s.tau.dot(s.v.tail(m));
+    const double P = s.tau.dot(eq.model().joint_coords(s.v));
     W += (last_P + 4.0 * Pm + P) * (t - last_t) / 6.0;
     s.input_work = W;
     last_t = t;

@@ -40,10 +40,10 @@ BlockMass block_mass(const Model& model, const VecX& q) {
   bm.L.resize(n);
   BaseKinematics bk;
   const VecX z = VecX::Zero(model.m());
-  base_kinematics(model, q.tail(model.m()), z, z, bk);
+  base_kinematics(model, model.joint_coords(q), z, z, bk);
   for (int k = 0; k < n; ++k) {
     RfePose pose;
-    rfe_pose(model.link.rfes[k], bk, q.segment<6>(6 * k), Vec6::Zero(), Vec6::Zero(), pose, false);
+    rfe_pose(model.link.rfes[k], bk, q.segment<6>(model.rfe_index(k)), Vec6::Zero(), Vec6::Zero(), pose, false);
     MatX border;
     Mat4 G;
     rfe_mass_blocks(model.link.rfes[k], pose, bk, bm.M[k], border, G);
@@ -143,7 +143,7 @@ ModeKind classify(const VecX& phi, const BlockMass& bm) {
 
 ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, int count, int dense_limit,
                           const std::vector<int>& free) {
-  const int n = model.n(), nf = static_cast<int>(free.size()), N = 6 * n + nf;
+  const int n = model.n(), nf = static_cast<int>(free.size()), N = model.flexible_dofs() + nf;
   if (n == 0) throw std::invalid_argument("modal analysis needs a flexible link (n ≥ 1)");
   if (std::set<int>(free.begin(), free.end()).size() != free.size())
     throw std::invalid_argument("a joint is freed twice");
@@ -155,13 +155,13 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
   ModesResult res;
   res.q0 = solve_static(model, qb, vb, TipLoads{}).q;
   VecX v = VecX::Zero(model.dof());
-  v.tail(model.m()) = vb;
+  model.joint_coords(v) = vb;
   std::vector<int> cols(model.m(), -1);
-  for (int i = 0; i < nf; ++i) cols[free[i]] = 6 * n + i;
+  for (int i = 0; i < nf; ++i) cols[free[i]] = model.flexible_dofs() + i;
   if (nf > 0) {  // a free joint must be in equilibrium where the held ones are
     VecX F;
     generalised_forces(model, res.q0, v, VecX::Zero(model.dof()), ForceTerms{}, F);
-    const VecX tau = F.tail(model.m());
+    const VecX tau = model.joint_coords(F);
     const double scale = std::max(1.0, tau.cwiseAbs().maxCoeff());
     for (int j : free)
       if (std::abs(tau[j]) > 1e-9 * scale)
@@ -187,7 +187,7 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
     MatX Md = MatX::Zero(N, N);
     if (nf > 0) Md = to_dense(pattern, Mv);
     else
-      for (int k = 0; k < n; ++k) Md.block<6, 6>(6 * k, 6 * k) = bm.M[k];
+      for (int k = 0; k < n; ++k) Md.block<6, 6>(model.rfe_index(k), model.rfe_index(k)) = bm.M[k];
     Eigen::GeneralizedSelfAdjointEigenSolver<MatX> es(to_dense(pattern, K), Md);
     if (es.info() != Eigen::Success) throw std::runtime_error("modal analysis: dense eigen-solver failed");
     lambda = es.eigenvalues().head(count);
@@ -245,7 +245,8 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
         lam[i] = ev[count - 1 - i];
         VecX u = U.col(count - 1 - i);
         for (int k = 0; k < n; ++k)  // φ = L⁻ᵀ u
-          shapes.col(i).segment<6>(6 * k) = bm.L[k].transpose().triangularView<Eigen::Upper>().solve(u.segment<6>(6 * k));
+          shapes.col(i).segment<6>(model.rfe_index(k)) =
+              bm.L[k].transpose().triangularView<Eigen::Upper>().solve(u.segment<6>(model.rfe_index(k)));
       }
     };
     lanczos(0.0, lambda, res.shapes);
@@ -259,7 +260,7 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
   double stiffest = 0.0;
   for (int k = 0; k < n; ++k)
     for (int i = 0; i < 6; ++i)
-      stiffest = std::max(stiffest, K[pattern.slot(6 * k + i, 6 * k + i)] / bm.M[k](i, i));
+      stiffest = std::max(stiffest, K[pattern.slot(model.rfe_index(k) + i, model.rfe_index(k) + i)] / bm.M[k](i, i));
   res.omega = lambda.cwiseMax(0.0).cwiseSqrt();
   for (int i = 0; i < count; ++i) {
     const bool rigid = nf > 0 && std::abs(lambda[i]) <= kRigidModeFraction * stiffest;

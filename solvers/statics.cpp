@@ -28,7 +28,7 @@ Vec6 tip_motion(const Model& model, const VecX& q) {
   const int n = model.n();
   Vec6 out = Vec6::Zero();
   if (n == 0) return out;
-  const Vec6 qn = q.segment<6>(6 * (n - 1));
+  const Vec6 qn = q.segment<6>(model.rfe_index(n - 1));
   DeformationTransform d;
   deformation_transform(qn, d);
   const Vec3& eta = model.link.tip_eta;
@@ -41,10 +41,10 @@ Vec3 tip_position(const Model& model, const VecX& q) {
   const int m = model.m(), n = model.n();
   BaseKinematics bk;
   const VecX z = VecX::Zero(m);
-  base_kinematics(model, q.tail(m), z, z, bk);
+  base_kinematics(model, model.joint_coords(q), z, z, bk);
   Vec3 local = Vec3(model.link.length, 0.0, 0.0);  // the rigid manipulator: the link's end, rigid with {r}
   if (n > 0) {
-    const Vec6 qn = q.segment<6>(6 * (n - 1));
+    const Vec6 qn = q.segment<6>(model.rfe_index(n - 1));
     DeformationTransform d;
     deformation_transform(qn, d, false);
     local = model.link.rfes.back().centre + qn.head<3>() + d.D.topLeftCorner<3, 3>() * model.link.tip_eta;
@@ -66,8 +66,8 @@ VecX residual(const Model& model, const VecX& q, const VecX& v, const TipLoads& 
   load_terms.sde = false;
   VecX L;
   generalised_forces(model, q, v, a, load_terms, L);
-  VecX r = F.head(6 * n) - (1.0 - lam) * L.head(6 * n);
-  r.segment<6>(6 * (n - 1)) -= lam * tip_generalised_force(model, q.segment<6>(6 * (n - 1)), loads);
+  VecX r = F.head(model.flexible_dofs()) - (1.0 - lam) * L.head(model.flexible_dofs());
+  r.segment<6>(model.rfe_index(n - 1)) -= lam * tip_generalised_force(model, q.segment<6>(model.rfe_index(n - 1)), loads);
   return r;
 }
 
@@ -78,10 +78,10 @@ StaticResult solve_static(const Model& model, const VecX& qb, const VecX& vb, co
   const int n = model.n(), m = model.m();
   StaticResult res;
   res.q = VecX::Zero(model.dof());
-  res.q.tail(m) = qb;
+  model.joint_coords(res.q) = qb;
   if (n == 0) return res;
   VecX v = VecX::Zero(model.dof());
-  v.tail(m) = vb;
+  model.joint_coords(v) = vb;
   const BorderedPattern pattern(n, 0);
   const std::vector<int> held(m, -1);
   CholmodSolver solver(pattern);
@@ -110,11 +110,11 @@ StaticResult solve_static(const Model& model, const VecX& qb, const VecX& vb, co
       if (!solver.factorize(values)) break;
       VecX dq = -r;
       solver.solve(dq);
-      q.head(6 * n) += dq;
+      q.head(model.flexible_dofs()) += dq;
       ++res.iterations;
       // Converged when the correction is at round-off of the coordinates (the residual itself
       // cannot drop below round-off of the stiff axial springs, c Δx ~ 1e8 N/m × 1e-15 m).
-      if (dq.lpNorm<Eigen::Infinity>() <= opts.step_tolerance * (1.0 + q.head(6 * n).lpNorm<Eigen::Infinity>())) {
+      if (dq.lpNorm<Eigen::Infinity>() <= opts.step_tolerance * (1.0 + q.head(model.flexible_dofs()).lpNorm<Eigen::Infinity>())) {
         res.residual = residual(model, q, v, loads, target).norm();
         ok = std::isfinite(res.residual);
         break;

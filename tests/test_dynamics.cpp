@@ -190,13 +190,13 @@ TEST(Dynamics, AngularMomentumAboutFreeVerticalJointIsConserved) {
   const Model m = test::spatial_arm(5, 1e-3);  // joint 1 turns about the vertical z0; gravity on
   const Trace tr = run(m, {free_joint(0.0, 0.7), law(deployment_law(0.3, 0.5, 1.5))}, tight(2.0));
   const BorderedPattern p(m.n(), m.m());
-  std::vector<int> cols{6 * m.n(), 6 * m.n() + 1};
+  std::vector<int> cols{m.flexible_dofs(), m.joint_index(1)};
   auto Lz = [&](const OutputSample& x) {  // ∂T/∂q̇1 = (M v)_1
     MatrixTerms t;
     t.mass = 1.0;
     std::vector<double> vals;
     assemble_matrix(m, p, cols, x.q, x.v, t, vals);
-    return (to_dense(p, vals) * x.v)[6 * m.n()];
+    return (to_dense(p, vals) * x.v)[m.flexible_dofs()];
   };
   const double L0 = Lz(tr.s.front());
   double worst = 0.0;
@@ -204,7 +204,7 @@ TEST(Dynamics, AngularMomentumAboutFreeVerticalJointIsConserved) {
   EXPECT_LT(worst, 1e-6 * std::abs(L0)) << "L0 = " << L0;
   // and joint 1 really reacts to joint 2's motion (the test is not trivially satisfied)
   double dv = 0.0;
-  for (const auto& x : tr.s) dv = std::max(dv, std::abs(x.v[6 * m.n()] - 0.7));
+  for (const auto& x : tr.s) dv = std::max(dv, std::abs(x.v[m.flexible_dofs()] - 0.7));
   EXPECT_GT(dv, 1e-2);
 }
 
@@ -234,7 +234,7 @@ TEST(Dynamics, KinematicTorquesAsForceInputReproduceTheMotion) {
   const Trace frc = run(m, forces, o);
   double worst = 0.0;
   for (size_t i = 0; i < frc.s.size(); ++i)
-    for (int j = 0; j < 2; ++j) worst = std::max(worst, std::abs(frc.s[i].q[6 * m.n() + j] - laws[j].motion->at(frc.s[i].t).q));
+    for (int j = 0; j < 2; ++j) worst = std::max(worst, std::abs(frc.s[i].q[m.joint_index(j)] - laws[j].motion->at(frc.s[i].t).q));
   // Open-loop: errors of both runs (rtol 1e-8) grow at most like t² on the free joints; a wrong
   // torque (any missing term) gives errors of order 1e-2 rad here.
   EXPECT_LT(worst, 1e-5);
@@ -267,9 +267,9 @@ TEST(Dynamics, SchurSolveEqualsDenseSolveOfFullNewtonSystem) {
   const Model m = test::spatial_arm(5, 3e-3);
   VecX q, v, a;
   test::random_state(m, 31, q, v, a);
-  q.head(6 * m.n()) *= 1e-3;  // a physical deformation: the random 5 cm would buckle the axial springs
+  q.head(m.flexible_dofs()) *= 1e-3;  // a physical deformation: the random 5 cm would buckle the axial springs
   const int N = m.dof();
-  NewtonSystem ns(m, {6 * m.n(), 6 * m.n() + 1}, 2, LinearSolverKind::Chain, nullptr, true);
+  NewtonSystem ns(m, {m.flexible_dofs(), m.joint_index(1)}, 2, LinearSolverKind::Chain, nullptr, true);
   const double c = 350.0;
   ASSERT_TRUE(ns.setup(q, v, 1.0 / c));
   const MatX M = dense_mass_matrix(m, q), C = dense_damping(m, q, v), K = dense_stiffness(m, q, false);

@@ -89,7 +89,7 @@ TEST(FreeBase, MomentumIsTheGeneralisedMomentumOfTheBaseCoordinates) {
   test::random_state(m, 7, q, v, a);
   const BorderedPattern p(m.n(), m.m());
   std::vector<int> cols(m.m());
-  for (int j = 0; j < m.m(); ++j) cols[j] = m.base_index(j);
+  for (int j = 0; j < m.m(); ++j) cols[j] = m.joint_index(j);
   MatrixTerms t;
   t.mass = 1.0;
   std::vector<double> vals;
@@ -104,7 +104,7 @@ TEST(FreeBase, MomentumIsTheGeneralisedMomentumOfTheBaseCoordinates) {
     const Mat4& W = bk.W[j];  // joint j's frame: its axis is W's rotation times the joint's axis
     const Vec3 u = W.topLeftCorner<3, 3>() * m.joints[j].axis, o = W.topRightCorner<3, 1>();
     const double expected = j < 3 ? P.linear.dot(u) : (P.angular - o.cross(P.linear)).dot(u);
-    EXPECT_NEAR(Mv[m.base_index(j)], expected, 1e-12 * scale) << m.joints[j].name;
+    EXPECT_NEAR(Mv[m.joint_index(j)], expected, 1e-12 * scale) << m.joints[j].name;
   }
 }
 
@@ -121,10 +121,10 @@ TEST(FreeBase, DeploymentOnAFreeBusKeepsMomentumZero) {
     const Momentum P = x.momentum;
     worst = std::max({worst, P.linear.norm(), P.angular.norm()});
     VecX held = x.v;
-    held.segment<free_base_dofs>(m.base_index(0)).setZero();
+    held.segment<free_base_dofs>(m.joint_index(0)).setZero();
     const Momentum A = momentum(m, x.q, held);
     scale = std::max({scale, A.linear.norm(), A.angular.norm()});
-    moved = std::max(moved, x.q.segment<free_base_dofs>(m.base_index(0)).cwiseAbs().maxCoeff());
+    moved = std::max(moved, x.q.segment<free_base_dofs>(m.joint_index(0)).cwiseAbs().maxCoeff());
   }
   RecordProperty("momentum_over_scale", std::to_string(worst / scale));
   EXPECT_LT(worst, 1e-6 * scale) << "scale " << scale;
@@ -145,5 +145,5 @@ TEST(FreeBase, RunStopsBeforeTheAnglesBecomeSingular) {
   EXPECT_NE(r.status.find("pitch"), std::string::npos) << r.status;
   ASSERT_FALSE(s.empty());
   EXPECT_GT(s.back().t, 1.5);
-  EXPECT_LT(std::abs(s.back().q[m.base_index(free_base_pitch)]), free_base_pitch_limit);
+  EXPECT_LT(std::abs(s.back().q[m.joint_index(free_base_pitch)]), free_base_pitch_limit);
 }

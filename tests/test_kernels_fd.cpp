@@ -56,7 +56,7 @@ ForceTerms only(bool inertia, bool gravity, bool sde) {
 MatX assembled(const Model& m, const VecX& q, const VecX& v, const MatrixTerms& t) {
   const BorderedPattern p(m.n(), m.m());
   std::vector<int> cols(m.m());
-  for (int j = 0; j < m.m(); ++j) cols[j] = 6 * m.n() + j;
+  for (int j = 0; j < m.m(); ++j) cols[j] = m.joint_index(j);
   std::vector<double> vals;
   assemble_matrix(m, p, cols, q, v, t, vals);
   return to_dense(p, vals);
@@ -203,8 +203,8 @@ TEST(KernelsFD, JointDrivesAreConsistent) {
   generalised_forces(bare, q, v, a, ForceTerms{}, Fb, &Pb);
   VecX expect = Fb;
   for (int j = 0; j < m.m(); ++j) {
-    const double vj = v[m.base_index(j)], aj = a[m.base_index(j)];
-    expect[m.base_index(j)] += 0.25 * aj + 0.6 * vj + 0.4 * std::tanh(vj / 0.3);
+    const double vj = v[m.joint_index(j)], aj = a[m.joint_index(j)];
+    expect[m.joint_index(j)] += 0.25 * aj + 0.6 * vj + 0.4 * std::tanh(vj / 0.3);
     Pb += vj * (0.6 * vj + 0.4 * std::tanh(vj / 0.3));
   }
   EXPECT_LT((F - expect).norm(), 1e-12 * Fb.norm());
@@ -215,7 +215,7 @@ TEST(KernelsFD, CentrifugalStiffnessIsJacobianOfInertialForce) {
   const Model m = test::spatial_arm(3);
   VecX q, v, a;
   test::random_state(m, 6, q, v, a);
-  v.head(6 * m.n()).setZero();  // the steady-rotation state: rfes at rest in {r}
+  v.head(m.flexible_dofs()).setZero();  // the steady-rotation state: rfes at rest in {r}
   const VecX zero = VecX::Zero(m.dof());
   MatrixTerms t;
   t.stiffness = 1.0;
@@ -227,7 +227,7 @@ TEST(KernelsFD, CentrifugalStiffnessIsJacobianOfInertialForce) {
   t.inertial = false;
   assemble_matrix(m, p, std::vector<int>(m.m(), -1), q, v, t, vals);
   const MatX Kinertial = Kc - to_dense(p, vals);
-  const int Nf = 6 * m.n();
+  const int Nf = m.flexible_dofs();
   const MatX Kfd = fd_jacobian(
       [&](const VecX& x) {
         VecX qq = q;

@@ -35,7 +35,7 @@ void random_state(const Model& m, unsigned seed, VecX& q, VecX& v, VecX& a) {
   v.resize(N);
   a.resize(N);
   for (int i = 0; i < N; ++i) {
-    const bool base = i >= 6 * m.n();
+    const bool base = i >= m.flexible_dofs();
     q[i] = (base ? 1.0 : 0.05) * u(gen);
     v[i] = (base ? 1.0 : 0.2) * u(gen);
     a[i] = u(gen);

@@ -157,8 +157,8 @@ TEST(PaperCase, PdFeedbackWithComputedTorqueTracksTheDeployment) {
     double e_closed = 0.0, e_open = 0.0;
     for (size_t i = 0; i < closed.s.size(); ++i) {
       const double ref = laws[j].motion->at(closed.s[i].t).q;
-      e_closed = std::max(e_closed, std::abs(closed.s[i].q[flex.base_index(j)] - ref));
-      e_open = std::max(e_open, std::abs(open.s[i].q[flex.base_index(j)] - ref));
+      e_closed = std::max(e_closed, std::abs(closed.s[i].q[flex.joint_index(j)] - ref));
+      e_open = std::max(e_open, std::abs(open.s[i].q[flex.joint_index(j)] - ref));
     }
     RecordProperty("joint" + std::to_string(j + 1) + "_pd_error_rad", std::to_string(e_closed));
     RecordProperty("joint" + std::to_string(j + 1) + "_open_loop_error_rad", std::to_string(e_open));
