@@ -1,15 +1,18 @@
 #!/usr/bin/env bash
-# rfem plot writes every expected PNG for the paper's case, and none is blank (pixel spread).
+# rfem plot writes every expected PNG for the paper's case (and the momentum of a free base), and
+# none is blank (pixel spread).
 set -euo pipefail
 source "$(dirname "$0")/cli_test_env.sh"
 "$rfem" run "$src/cases/paper_deployment.toml" --quiet --set simulation.t_end=4 -o paper.h5
 "$rfem" plot paper.h5 -o figs >/dev/null
+"$rfem" run "$src/cases/space_deployment.toml" --quiet --n 2 --set simulation.t_end=4 -o space.h5 2>/dev/null
+"$rfem" plot space.h5 -o figs >/dev/null
 /usr/bin/python3 - figs <<'PY'
 import sys, os
 import matplotlib.image as mpimg
 d = sys.argv[1]
 expected = ["fig5_tip", "fig6_torque3", "fig7_velocity3", "fig8_accel12"] + \
-    [f"{g}_{k}" for g in ("rigid", "kinematic", "force") for k in ("joints", "tip", "energy")]
+    [f"{g}_{k}" for g in ("rigid", "kinematic", "force") for k in ("joints", "tip", "energy")] + ["run_momentum"]
 bad = 0
 for name in expected:
     path = os.path.join(d, name + ".png")

@@ -4,7 +4,8 @@
     /usr/bin/python3 tools/rfem_plot.py RESULT.h5 [-o OUTDIR]
 
 Writes PNGs into OUTDIR (default: the directory of RESULT.h5):
-  * for every run group G: G_joints.png, G_tip.png, G_energy.png;
+  * for every run group G: G_joints.png, G_tip.png, G_energy.png, and G_momentum.png on a free
+    base (linear and angular momentum: constant without gravity);
   * for procedure "paper": fig5_tip.png, fig6_torque3.png, fig7_velocity3.png, fig8_accel12.png
     (the layout of the paper's Figures 5-8);
   * for a file with a `refine` group: refine_convergence.png (and refine_convergence_qK.png for
@@ -25,7 +26,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 DPI = 120
-SERIES = ["joint_q", "joint_v", "joint_a", "joint_tau", "tip_deflection", "energy"]
+SERIES = ["joint_q", "joint_v", "joint_a", "joint_tau", "tip_deflection", "energy", "momentum"]
 TIP_LABELS = [("u1", "u1 [m]"), ("u2", "u2 [m]"), ("theta", "θ [rad]")]
 ENERGY_LABELS = ["kinetic", "elastic", "gravity", "input work", "dissipated"]
 ENERGY_STYLES = ["-", "-", "-", "--", ":"]
@@ -169,6 +170,19 @@ def plot_run(run, outdir):
         finish(ax2, "t [s]", "balance drift [J]")
         fig.tight_layout()
         save(fig, outdir, "%s_energy.png" % g)
+    # Momentum of a free-floating base's system (joints base_x … base_roll come first).
+    if "momentum" in run.data and run.joints[:1] == ["base_x"]:
+        p = run.data["momentum"]
+        fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(8, 6))
+        for j, name in enumerate(["px", "py", "pz"]):
+            ax1.plot(run.t, p[:, j], label=name)
+        finish(ax1, ylabel="linear momentum [kg m/s]")
+        ax1.set_title(run.title("momentum of all bodies (constant without gravity)"))
+        for j, name in enumerate(["Lx", "Ly", "Lz"]):
+            ax2.plot(run.t, p[:, 3 + j], label=name)
+        finish(ax2, "t [s]", "angular momentum about {0} [kg m²/s]")
+        fig.tight_layout()
+        save(fig, outdir, "%s_momentum.png" % g)
 
 
 def compare(ax, runs_series, ylabel, xlabel=None):
