@@ -451,7 +451,8 @@ void read_base(const Reader& r, const toml::node* bn, const std::map<std::string
                             "roll_rate"});
   const std::string kind = r.string(bt, "base", "kind", std::string("fixed"));
   if (kind == "fixed") {
-    if (bt.size() > 1) r.fail(&bt, "base", "a fixed base takes no other keys (kind = \"free\" for a floating one)");
+    // (the free base's keys stay legal, so `--set base.kind=fixed` compares the two)
+    if (bt.size() > 1) r.warn(&bt, "base", "kind = \"fixed\": the first joint sits on the ground; the other keys are not used");
     return;
   }
   if (kind != "free") r.fail(bt.get("kind"), "base.kind", "must be \"fixed\" or \"free\" (got \"" + kind + "\")");
