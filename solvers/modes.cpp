@@ -128,6 +128,17 @@ class MassProductOp {
   const std::vector<double>& M_;
 };
 
+// Runs a Spectra shift-invert solver: its eigenvalues ascending with their vectors (Spectra returns
+// the eigenvalues back-transformed, largest 1/(λ−σ) first).
+template <class Eigs>
+void ascending(Eigs& eigs, VecX& lam, MatX& vectors) {
+  eigs.init();
+  eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
+  if (eigs.info() != Spectra::CompInfo::Successful) throw std::runtime_error("modal analysis: Lanczos did not converge");
+  lam = eigs.eigenvalues().reverse();
+  vectors = eigs.eigenvectors().rowwise().reverse();
+}
+
 ModeKind classify(const VecX& phi, const BlockMass& bm) {
   double w[4] = {0, 0, 0, 0};  // axial, bending-y (x2, φ3), bending-z (x3, φ2), torsion (φ1)
   static const int kind_of[6] = {0, 1, 2, 3, 2, 1};
@@ -192,67 +203,45 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
     if (es.info() != Eigen::Success) throw std::runtime_error("modal analysis: dense eigen-solver failed");
     lambda = es.eigenvalues().head(count);
     res.shapes = es.eigenvectors().leftCols(count);
-  } else if (nf > 0) {
-    res.dense = false;
-    // Rigid-body modes sit at λ = 0, where K − σM is singular: shift below zero, then once more
-    // further down for the uncertainty estimate (as below).
-    const double scale = 1e-3 * std::abs(K[pattern.diag(n - 1)] / Mv[pattern.diag(n - 1)]);
-    auto lanczos = [&](double sigma, VecX& lam, MatX& shapes) {
-      GeneralShiftInvertOp op(pattern, K, Mv);
-      MassProductOp bop(pattern, Mv);
-      const int ncv = std::min(N, std::max(2 * count + 1, count + 20));
-      Spectra::SymGEigsShiftSolver<GeneralShiftInvertOp, MassProductOp, Spectra::GEigsMode::ShiftInvert> eigs(
-          op, bop, count, ncv, sigma);
-      eigs.init();
-      eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
-      if (eigs.info() != Spectra::CompInfo::Successful) throw std::runtime_error("modal analysis: Lanczos did not converge");
-      const VecX ev = eigs.eigenvalues();
-      const MatX U = eigs.eigenvectors();
-      lam.resize(count);
-      shapes.resize(N, count);
-      for (int i = 0; i < count; ++i) {
-        lam[i] = ev[count - 1 - i];
-        shapes.col(i) = U.col(count - 1 - i);
-      }
-    };
-    lanczos(-1e-6 * scale, lambda, res.shapes);
-    VecX check;
-    MatX check_shapes;
-    double first_elastic = lambda[count - 1];  // (as σ = −λ₁ below, on the first non-rigid mode)
-    for (int i = count - 1; i >= 0; --i)
-      if (lambda[i] > 1e-9 * scale) first_elastic = lambda[i];
-    lanczos(-1e-6 * scale - std::max(std::abs(first_elastic), 1e-12), check, check_shapes);
-    res.uncertainty = ((check - lambda).cwiseAbs().array() / lambda.cwiseAbs().array().max(1e-300)).matrix();
   } else {
     res.dense = false;
-    // Shift-invert Lanczos at σ = 0, then once more at σ = −λ₁: the factorisations of K − σM
-    // differ in their round-off (the stiff axial springs make K ill-conditioned for many rfes), so
-    // the change of the eigenvalues estimates their error. (The residual ‖Kφ − λMφ‖ does not: it
-    // is dominated by the round-off of Kφ itself and flags accurate modes from n ≈ 80 on.)
+    // Shift-invert Lanczos twice, at σ₁ and σ₁ − λ₁ (λ₁ the first elastic eigenvalue): the
+    // factorisations of K − σM differ in their round-off (the stiff axial springs make K
+    // ill-conditioned for many rfes), so the change of the eigenvalues estimates their error. (The
+    // residual ‖Kφ − λMφ‖ does not: it is dominated by the round-off of Kφ itself and flags accurate
+    // modes from n ≈ 80 on.) Held joints: M is block diagonal, the standard problem L⁻¹KL⁻ᵀ at
+    // σ₁ = 0. Free joints: M is bordered, the generalised problem, and σ₁ just below 0, where the
+    // rigid-body modes make K singular.
+    const int ncv = std::min(N, std::max(2 * count + 1, count + 20));
+    const double scale = 1e-3 * std::abs(K[pattern.diag(n - 1)] / bm.M[n - 1](0, 0));
     auto lanczos = [&](double sigma, VecX& lam, MatX& shapes) {
+      if (nf > 0) {
+        GeneralShiftInvertOp op(pattern, K, Mv);
+        MassProductOp bop(pattern, Mv);
+        Spectra::SymGEigsShiftSolver<GeneralShiftInvertOp, MassProductOp, Spectra::GEigsMode::ShiftInvert> eigs(
+            op, bop, count, ncv, sigma);
+        ascending(eigs, lam, shapes);
+        return;
+      }
       ShiftInvertOp op(pattern, K, bm);
-      const int ncv = std::min(N, std::max(2 * count + 1, count + 20));
       Spectra::SymEigsShiftSolver<ShiftInvertOp> eigs(op, count, ncv, sigma);
-      eigs.init();
-      eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
-      if (eigs.info() != Spectra::CompInfo::Successful) throw std::runtime_error("modal analysis: Lanczos did not converge");
-      const VecX ev = eigs.eigenvalues();
-      const MatX U = eigs.eigenvectors();
-      // Spectra returns the eigenvalues of A (back-transformed), largest 1/(λ−σ) first: reverse.
-      lam.resize(count);
+      MatX U;
+      ascending(eigs, lam, U);
       shapes.resize(N, count);
-      for (int i = 0; i < count; ++i) {
-        lam[i] = ev[count - 1 - i];
-        VecX u = U.col(count - 1 - i);
+      for (int i = 0; i < count; ++i)
         for (int k = 0; k < n; ++k)  // φ = L⁻ᵀ u
           shapes.col(i).segment<6>(model.rfe_index(k)) =
-              bm.L[k].transpose().triangularView<Eigen::Upper>().solve(u.segment<6>(model.rfe_index(k)));
-      }
+              bm.L[k].transpose().triangularView<Eigen::Upper>().solve(U.col(i).segment<6>(model.rfe_index(k)));
     };
-    lanczos(0.0, lambda, res.shapes);
+    const double sigma = nf > 0 ? -1e-6 * scale : 0.0;
+    lanczos(sigma, lambda, res.shapes);
+    double first_elastic = lambda[0];
+    if (nf > 0)
+      for (int i = count - 1; i >= 0; --i)
+        if (lambda[i] > 1e-9 * scale) first_elastic = lambda[i];
     VecX check;
     MatX check_shapes;
-    lanczos(-std::max(std::abs(lambda[0]), 1e-12), check, check_shapes);
+    lanczos(sigma - std::max(std::abs(first_elastic), 1e-12), check, check_shapes);
     res.uncertainty = ((check - lambda).cwiseAbs().array() / lambda.cwiseAbs().array().max(1e-300)).matrix();
   }
   if (res.uncertainty.size() == 0) res.uncertainty = VecX::Zero(count);
