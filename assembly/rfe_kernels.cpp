@@ -116,18 +116,23 @@ Mat6 rfe_inertial_stiffness(const Rfe& rfe, const RfePose& p, const BaseKinemati
   return 0.5 * (K + K.transpose());
 }
 
-double rfe_kinetic_energy(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, const Vec6& v) {
+namespace {
+// Top rows of Ẇ = Ḃ0 P + B0 Ṗ with P = C D.
+Mat34 rfe_velocity(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, const Vec6& v) {
   Mat4 P = p.d.D;
   P.topRightCorner<3, 1>() += rfe.centre;
-  const Mat34 Wd = (bk.B0d * P).topRows<3>() + lift(bk.B0, d_dot(p.d, v));
+  return (bk.B0d * P).topRows<3>() + lift(bk.B0, d_dot(p.d, v));
+}
+}  // namespace
+
+double rfe_kinetic_energy(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, const Vec6& v) {
+  const Mat34 Wd = rfe_velocity(rfe, p, bk, v);
   return 0.5 * trace_AHBt(Wd, rfe.H, Wd);
 }
 
 void rfe_momentum_moments(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, const Vec6& v, Vec3& lin,
                           Mat3& A) {
-  Mat4 P = p.d.D;
-  P.topRightCorner<3, 1>() += rfe.centre;
-  const Mat34 Wd = (bk.B0d * P).topRows<3>() + lift(bk.B0, d_dot(p.d, v));
+  const Mat34 Wd = rfe_velocity(rfe, p, bk, v);
   const Mat34 WH = p.W.topRows<3>() * rfe.H;
   lin = Wd * rfe.H.col(3);
   A = WH * Wd.transpose();
