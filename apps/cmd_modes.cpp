@@ -12,9 +12,11 @@ namespace rfem::app {
 namespace {
 // Exact cantilever values apply to one uniform segment without payloads on a held, non-rotating
 // base without gravity.
-bool has_exact_reference(const Case& cs, const VecX& vb, bool held) {
-  return held && cs.has_link && cs.link.segments.size() == 1 && cs.link.payloads.empty() && cs.gravity == 0.0 && (vb.size() == 0 || vb.norm() == 0.0) &&
-         cs.link.segments[0].section.offset.norm() == 0.0;
+bool has_exact_reference(const Case& cs, const Model& model, const VecX& vb, bool held) {
+  if (!held || cs.links.size() != 1 || model.carrying > 0) return false;
+  const FlexibleLink& l = cs.links[0].link;
+  return l.segments.size() == 1 && l.payloads.empty() && cs.gravity == 0.0 && (vb.size() == 0 || vb.norm() == 0.0) &&
+         l.segments[0].section.offset.norm() == 0.0;
 }
 // --free entries: joint numbers from 1, joint names, or "base" (the six of a free base).
 std::vector<int> free_joints(const Case& cs, const Model& model, const std::vector<std::string>& names) {
@@ -59,7 +61,7 @@ int run_modes(const Common& c, const ModesOptions& o) {
   } catch (const std::invalid_argument& e) {
     throw CaseError(cs.path + ": --free: " + e.what());
   }
-  const bool exact = has_exact_reference(cs, vb, freed.empty());
+  const bool exact = has_exact_reference(cs, model, vb, freed.empty());
   int seen[5] = {0, 0, 0, 0, 0};
   std::vector<std::string> freed_names;
   for (int j : freed) freed_names.push_back(model.joints[j].name);
@@ -81,7 +83,7 @@ int run_modes(const Common& c, const ModesOptions& o) {
                          {"index_of_kind", k}, {"uncertainty", r.uncertainty[i]}};
     std::string extra;
     if (exact) {
-      const Segment& sg = cs.link.segments[0];
+      const Segment& sg = cs.links[0].link.segments[0];
       const bool bending = r.kind[i] == ModeKind::BendingY || r.kind[i] == ModeKind::BendingZ;
       const double fr = (bending ? beam::cantilever_omega_timoshenko(sg, r.kind[i], k) : beam::cantilever_omega(sg, r.kind[i], k)) /
                         (2 * M_PI);

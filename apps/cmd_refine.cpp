@@ -17,16 +17,40 @@ namespace rfem::app {
 
 namespace {
 
-// A static or modal quantity: "tip:ux|uy|uz|rx|ry|rz", "mode:K", "axial:K", "bending-y:K",
-// "bending-z:K", "torsion:K".
+// "A/B/Q": the prefixes A, B and the quantity Q. A prefix that names a link of the case sets
+// `link`; any other is the run (`run`, empty if none). Throws for more prefixes than that.
+std::string split_prefixes(const Case& cs, const std::string& quantity, std::string& run, int& link) {
+  std::string q = quantity;
+  run.clear();
+  link = -1;
+  for (auto slash = q.find('/'); slash != std::string::npos; slash = q.find('/')) {
+    const std::string p = q.substr(0, slash);
+    q = q.substr(slash + 1);
+    int l = -1;
+    for (size_t i = 0; i < cs.links.size(); ++i)
+      if (cs.links[i].name == p) l = static_cast<int>(i);
+    if (l >= 0 && link < 0) link = l;
+    else if (l < 0 && run.empty() && link < 0) run = p;
+    else throw CaseError("--quantity " + quantity + ": expected [RUN/][LINK/]QUANTITY ('" + p + "' is not where a run or link goes)");
+  }
+  return q;
+}
+
+// A static or modal quantity: "[LINK/]tip:ux|uy|uz|rx|ry|rz" (the last link by default),
+// "mode:K", "axial:K", "bending-y:K", "bending-z:K", "torsion:K".
 struct StaticQuantity {
   std::string what;
   int index = 0;  // tip component 0..5, or mode K ≥ 1
+  int link = -1;  // tip: the link (−1: the last)
 };
 
-StaticQuantity parse_static(const std::string& quantity) {
-  const auto colon = quantity.find(':');
+StaticQuantity parse_static(const Case& cs, const std::string& text) {
   StaticQuantity s;
+  std::string run;
+  const std::string quantity = split_prefixes(cs, text, run, s.link);
+  if (!run.empty()) throw CaseError("--quantity " + text + ": no link named '" + run + "'");
+  if (s.link >= 0 && quantity.rfind("tip:", 0) != 0) throw CaseError("--quantity " + text + ": only tip quantities name a link");
+  const auto colon = quantity.find(':');
   s.what = quantity.substr(0, colon);
   const std::string arg = colon == std::string::npos ? "" : quantity.substr(colon + 1);
   if (s.what == "tip") {
@@ -40,8 +64,8 @@ StaticQuantity parse_static(const std::string& quantity) {
   }
   if (s.what != "mode" && s.what != "axial" && s.what != "bending-y" && s.what != "bending-z" && s.what != "torsion")
     throw CaseError("--quantity " + quantity + ": unknown quantity '" + s.what +
-                    "' (tip:ux…rz, mode:K, axial:K, bending-y:K, bending-z:K, torsion:K, [RUN/]peak:u1|u2|theta, "
-                    "[RUN/]u1@T, u2@T, theta@T, tauJ@T, qJ@T)");
+                    "' ([LINK/]tip:ux…rz, mode:K, axial:K, bending-y:K, bending-z:K, torsion:K, "
+                    "[RUN/][LINK/]peak:u1|u2|theta, [RUN/][LINK/]u1@T, u2@T, theta@T, [RUN/]tauJ@T, qJ@T)");
   size_t used = 0;
   try {
     s.index = std::stoi(arg, &used);
@@ -57,7 +81,11 @@ double evaluate_static(const Case& cs, int n, const StaticQuantity& s, const std
   const Model model = build_model(cs, n);
   VecX qb, vb;
   joint_state(cs, o, qb, vb);
-  if (s.what == "tip") return tip_motion(model, solve_static(model, qb, vb, cs.loads).q)[s.index];
+  if (s.what == "tip") {
+    if (model.links.empty()) throw CaseError("--quantity " + quantity + ": the case has no flexible link");
+    const int l = s.link >= 0 ? s.link : static_cast<int>(model.links.size()) - 1;
+    return tip_motion(model, l, solve_static(model, qb, vb, cs.loads).q)[s.index];
+  }
   const int k = s.index;
   if (s.what == "mode") {
     if (k > model.flexible_dofs())
@@ -77,24 +105,21 @@ double evaluate_static(const Case& cs, int n, const StaticQuantity& s, const std
                            " at n = " + std::to_string(n));
 }
 
-// A dynamic quantity "[RUN/]peak:u1|u2|theta", "[RUN/]u1@T", "u2@T", "theta@T", "tauJ@T", "qJ@T"
-// (J 1-based).
+// A dynamic quantity "[RUN/][LINK/]peak:u1|u2|theta", "[RUN/][LINK/]u1@T", "u2@T", "theta@T",
+// "[RUN/]tauJ@T", "qJ@T" (J 1-based; the last link by default).
 struct DynamicQuantity {
   std::string run, what;
   double time = -1.0;  // < 0: peak over the run
   int joint = -1;
+  int link = -1;
 };
 
 // Returns false if `quantity` is not dynamic; throws CaseError if it is but cannot be evaluated.
 bool parse_dynamic(const Case& cs, const std::string& quantity, DynamicQuantity& d) {
-  std::string q = quantity;
-  const auto slash = q.find('/');
   const bool paper = cs.sim.procedure == "paper";
-  d.run = paper ? "kinematic" : "run";
-  if (slash != std::string::npos) {
-    d.run = q.substr(0, slash);
-    q = q.substr(slash + 1);
-  }
+  const bool prefixed = quantity.find('/') != std::string::npos;
+  const std::string q = split_prefixes(cs, quantity, d.run, d.link);
+  if (d.run.empty()) d.run = paper ? "kinematic" : "run";
   if (q.rfind("peak:", 0) == 0) {
     d.what = q.substr(5);
   } else if (const auto at = q.find('@'); at != std::string::npos) {
@@ -108,7 +133,7 @@ bool parse_dynamic(const Case& cs, const std::string& quantity, DynamicQuantity&
     if (used == 0 || used != q.size() - at - 1 || !std::isfinite(d.time))
       throw CaseError("--quantity " + quantity + ": '" + q.substr(at + 1) + "' is not a time");
   } else {
-    if (slash != std::string::npos) throw CaseError("--quantity " + quantity + ": expected RUN/peak:X or RUN/X@T");
+    if (prefixed && q.rfind("tip:", 0) != 0) throw CaseError("--quantity " + quantity + ": expected RUN/peak:X or RUN/X@T");
     return false;
   }
   if (d.what.rfind("tau", 0) == 0 || (d.what.size() > 1 && d.what[0] == 'q' && std::isdigit(d.what[1]))) {
@@ -117,8 +142,11 @@ bool parse_dynamic(const Case& cs, const std::string& quantity, DynamicQuantity&
     if (d.joint < 1 || d.joint > static_cast<int>(cs.joints.size()))
       throw CaseError("--quantity " + quantity + ": joint must be 1.." + std::to_string(cs.joints.size()));
     d.what = d.what[0] == 'q' ? "q" : "tau";
+    if (d.link >= 0) throw CaseError("--quantity " + quantity + ": joint quantities name no link");
   } else if (d.what != "u1" && d.what != "u2" && d.what != "theta") {
     throw CaseError("--quantity " + quantity + ": expected u1, u2, theta, tauJ or qJ");
+  } else if (cs.links.empty()) {
+    throw CaseError("--quantity " + quantity + ": the case has no flexible link");
   }
   if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: a dynamic quantity needs a [simulation] table");
   const bool known = paper ? (d.run == "rigid" || d.run == "kinematic" || d.run == "force") : d.run == "run";
@@ -159,7 +187,7 @@ std::vector<double> evaluate_dynamic(const Case& cs, const std::vector<JointInpu
       double x = 0.0;
       if (d.what == "tau") x = s.tau[d.joint - 1];
       else if (d.what == "q") x = s.q[m.joint_index(d.joint - 1)];
-      else x = tip_deflection(m, s.q)[d.what == "u1" ? 0 : d.what == "u2" ? 1 : 2];
+      else x = tip_deflection(m, d.link >= 0 ? d.link : static_cast<int>(m.links.size()) - 1, s.q)[d.what == "u1" ? 0 : d.what == "u2" ? 1 : 2];
       if (d.time < 0) value[i] = std::max(value[i], std::abs(x));
       else if (std::abs(s.t - d.time) < best_dt[i]) best_dt[i] = std::abs(s.t - d.time), value[i] = x;
     }
@@ -239,7 +267,7 @@ void print_tables(const Case& cs, const std::vector<Quantity>& qs, const std::ve
 }  // namespace
 
 double evaluate_quantity(const Case& cs, int n, const std::string& quantity, const ModesOptions& o) {
-  return evaluate_static(cs, n, parse_static(quantity), quantity, o);
+  return evaluate_static(cs, n, parse_static(cs, quantity), quantity, o);
 }
 
 int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) {
@@ -256,7 +284,7 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
     Quantity q;
     q.text = text;
     q.dynamic = parse_dynamic(cs, text, q.d);
-    if (!q.dynamic) q.s = parse_static(text);
+    if (!q.dynamic) q.s = parse_static(cs, text);
     dynamic |= q.dynamic;
     qs.push_back(q);
   }

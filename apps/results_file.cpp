@@ -115,10 +115,26 @@ void ResultsFile::end_swmr() {
   flush();
 }
 
-Eigen::Vector3d tip_deflection(const Model& model, const VecX& q) {
-  const Vec6 t = tip_motion(model, q);
+Eigen::Vector3d tip_deflection(const Model& model, int l, const VecX& q) {
+  const Vec6 t = tip_motion(model, l, q);
   return {t[1], t[2], t[3]};
 }
+
+namespace {
+// A constant 2-D dataset (rows × columns) with its columns, units and description.
+void constant_dataset(hid_t group, const std::string& name, const std::vector<double>& rows_cols, hsize_t cols,
+                      const std::vector<std::string>& columns, const std::vector<std::string>& units, const std::string& what) {
+  const hsize_t dims[2] = {rows_cols.size() / cols, cols};
+  const hid_t sp = H5Screate_simple(2, dims, nullptr);
+  const hid_t d = H5Dcreate2(group, name.c_str(), H5T_NATIVE_DOUBLE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows_cols.data());
+  write_attribute(d, "columns", columns);
+  write_attribute(d, "units", units);
+  write_attribute(d, "description", what);
+  H5Dclose(d);
+  H5Sclose(sp);
+}
+}  // namespace
 
 RunGroup::RunGroup(ResultsFile& file, const std::string& name, const Model& model, int flexible_every)
     : file_(file), model_(model), name_(name), flexible_every_(flexible_every), last_flush_(std::chrono::steady_clock::now()) {
@@ -129,7 +145,7 @@ RunGroup::RunGroup(ResultsFile& file, const std::string& name, const Model& mode
   H5Pclose(lcpl);
   if (group_ < 0) throw std::runtime_error(file.path() + ": cannot create group " + name);
   const int m = model.m(), n = model.n();
-  std::vector<std::string> jn, jt, ju, rate, acc, tau;
+  std::vector<std::string> jn, jt, ju, rate, acc, tau, jp, jpu;
   for (const auto& j : model.joints) {
     const bool rev = j.type == JointType::Revolute;
     jn.push_back(j.name);
@@ -138,45 +154,62 @@ RunGroup::RunGroup(ResultsFile& file, const std::string& name, const Model& mode
     rate.push_back(rev ? "rad/s" : "m/s");
     acc.push_back(rev ? "rad/s^2" : "m/s^2");
     tau.push_back(rev ? "N m" : "N");
+    for (const char* c : {".x", ".y", ".z"}) {
+      jp.push_back(j.name + c);
+      jpu.push_back("m");
+    }
   }
   add_series("time", {"t"}, {"s"});
   add_series("joint_q", jn, ju, "joint coordinates");
   add_series("joint_v", jn, rate, "joint rates");
   add_series("joint_a", jn, acc, "joint accelerations (of the integrator's continuous solution)");
   add_series("joint_tau", jn, tau, "applied torque/force (force input) or required (kinematic input)");
-  add_series("tip", {"ux", "uy", "uz", "rx", "ry", "rz"}, {"m", "m", "m", "rad", "rad", "rad"},
-             "free end on the elastic axis: displacement from undeformed and rotation φ of rfe_n, in {r} axes");
-  add_series("tip_position", {"x", "y", "z"}, {"m", "m", "m"}, "free end on the elastic axis, in the inertial frame {0}");
-  add_series("tip_deflection", {"u1", "u2", "theta"}, {"m", "m", "rad"},
-             "the paper's tip deflections: u1 along y of {r}, u2 along z of {r}, theta the torsion phi1 of rfe_n");
+  add_series("joint_position", jp, jpu, "origin of each joint's frame (of the body it moves) in the inertial frame {0}");
   add_series("energy", {"kinetic", "elastic", "gravity", "input_work", "dissipated", "balance"},
              {"J", "J", "J", "J", "J", "J"}, "balance = kinetic + elastic + gravity + dissipated - input_work");
   add_series("momentum", {"px", "py", "pz", "Lx", "Ly", "Lz"}, {"kg m/s", "kg m/s", "kg m/s", "kg m2/s", "kg m2/s", "kg m2/s"},
              "linear momentum and angular momentum about the origin of {0} of every body (drive rotors left out)");
-  if (flexible_every_ > 0 && n > 0) {
-    add_series("flexible_time", {"t"}, {"s"});
-    std::vector<std::string> cols, units;
-    for (int k = 1; k <= n; ++k)
-      for (const char* c : {"x1", "x2", "x3", "phi1", "phi2", "phi3"}) {
-        cols.push_back("rfe" + std::to_string(k) + "." + c);
-        units.push_back(c[0] == 'x' ? "m" : "rad");
-      }
-    add_series("flexible_q", cols, units,
-               "rfe coordinates [2.2]: mass-centre displacement from rfe_centre and angles of R = RotY(phi2) "
-               "RotZ(phi3) RotX(phi1), in {r} axes");
+  add_series("centre_of_mass", {"x", "y", "z"}, {"m", "m", "m"}, "centre of mass of every body in {0}");
+  if (flexible_every_ > 0 && n > 0) add_series("flexible_time", {"t"}, {"s"});
+  // Per link, in links/NAME/; the last link's also at the top (soft links): the layout of one link.
+  for (const MountedLink& L : model.links) {
+    const std::string g = "links/" + L.name + "/";
+    add_series(g + "tip", {"ux", "uy", "uz", "rx", "ry", "rz"}, {"m", "m", "m", "rad", "rad", "rad"},
+               "free end on the elastic axis: displacement from undeformed and rotation φ of rfe_n, in {r} axes");
+    add_series(g + "tip_position", {"x", "y", "z"}, {"m", "m", "m"}, "free end on the elastic axis, in the inertial frame {0}");
+    add_series(g + "tip_deflection", {"u1", "u2", "theta"}, {"m", "m", "rad"},
+               "the paper's tip deflections: u1 along y of {r}, u2 along z of {r}, theta the torsion phi1 of rfe_n");
+    {
+      std::vector<std::string> cols, units;
+      for (size_t i = 1; i <= L.d.payloads.size(); ++i)
+        for (const char* c : {".x", ".y", ".z"}) {
+          cols.push_back("payload" + std::to_string(i) + c);
+          units.push_back("m");
+        }
+      if (!cols.empty())
+        add_series(g + "payload_position", cols, units, "reference point of each payload (on the elastic axis) in {0}");
+    }
+    if (L.n() == 0) continue;
+    if (flexible_every_ > 0) {
+      std::vector<std::string> cols, units;
+      for (int k = 1; k <= L.n(); ++k)
+        for (const char* c : {"x1", "x2", "x3", "phi1", "phi2", "phi3"}) {
+          cols.push_back("rfe" + std::to_string(k) + "." + c);
+          units.push_back(c[0] == 'x' ? "m" : "rad");
+        }
+      add_series(g + "flexible_q", cols, units,
+                 "rfe coordinates [2.2]: mass-centre displacement from rfe_centre and angles of R = RotY(phi2) "
+                 "RotZ(phi3) RotX(phi1), in {r} axes");
+    }
+    std::vector<double> c;  // the undeformed mass centres in {r}: flexible_q is relative to these
+    for (const auto& r : L.d.rfes) c.insert(c.end(), {r.centre[0], r.centre[1], r.centre[2]});
+    constant_dataset(group_, g + "rfe_centre", c, 3, {"x", "y", "z"}, {"m", "m", "m"},
+                     "undeformed mass centre of rfe k (row k-1) in {r}");
   }
-  if (n > 0) {  // the undeformed mass centres in {r}: flexible_q is relative to these
-    const hsize_t dims[2] = {static_cast<hsize_t>(n), 3};
-    const hid_t sp = H5Screate_simple(2, dims, nullptr);
-    const hid_t d = H5Dcreate2(group_, "rfe_centre", H5T_NATIVE_DOUBLE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    std::vector<double> c;
-    for (const auto& r : model.link.rfes) c.insert(c.end(), {r.centre[0], r.centre[1], r.centre[2]});
-    H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, c.data());
-    write_attribute(d, "columns", std::vector<std::string>{"x", "y", "z"});
-    write_attribute(d, "units", std::vector<std::string>{"m", "m", "m"});
-    write_attribute(d, "description", std::string("undeformed mass centre of rfe k (row k-1) in {r}"));
-    H5Dclose(d);
-    H5Sclose(sp);
+  if (!model.links.empty()) {
+    const std::string g = "links/" + model.links.back().name + "/";
+    for (const char* d : {"tip", "tip_position", "tip_deflection", "rfe_centre", "flexible_q", "payload_position"})
+      if (H5Lexists(group_, (g + d).c_str(), H5P_DEFAULT) > 0) H5Lcreate_soft((g + d).c_str(), group_, d, H5P_DEFAULT, H5P_DEFAULT);
   }
   {  // the live status: a fixed-size string, writable while the file is in SWMR mode
     const hid_t type = H5Tcopy(H5T_C_S1);
@@ -186,11 +219,14 @@ RunGroup::RunGroup(ResultsFile& file, const std::string& name, const Model& mode
     H5Sclose(sp);
     H5Tclose(type);
   }
+  std::vector<std::string> link_names;
+  for (const MountedLink& L : model.links) link_names.push_back(L.name);
   write_attribute(group_, "n", static_cast<long>(n));
   write_attribute(group_, "m", static_cast<long>(m));
   write_attribute(group_, "joint_names", jn);
   write_attribute(group_, "joint_types", jt);
   write_attribute(group_, "joint_units", ju);
+  if (!link_names.empty()) write_attribute(group_, "link_names", link_names);
   write_attribute(group_, "status", std::string("running"));
   status("running");
   file.begin_swmr();
@@ -227,7 +263,10 @@ void RunGroup::add_series(const std::string& name, const std::vector<std::string
   const hid_t plist = H5Pcreate(H5P_DATASET_CREATE);
   const hsize_t chunk[2] = {std::max<hsize_t>(1, std::min<hsize_t>(256, (1 << 16) / dims[1])), dims[1]};
   H5Pset_chunk(plist, 2, chunk);
-  const hid_t d = H5Dcreate2(group_, name.c_str(), H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, plist, H5P_DEFAULT);
+  const hid_t lcpl = H5Pcreate(H5P_LINK_CREATE);  // "links/NAME/tip" creates its groups
+  H5Pset_create_intermediate_group(lcpl, 1);
+  const hid_t d = H5Dcreate2(group_, name.c_str(), H5T_NATIVE_DOUBLE, space, lcpl, plist, H5P_DEFAULT);
+  H5Pclose(lcpl);
   H5Pclose(plist);
   H5Sclose(space);
   write_attribute(d, "columns", columns.empty() ? std::vector<std::string>{"(none)"} : columns);
@@ -258,16 +297,14 @@ void RunGroup::append(const OutputSample& s) {
     write_row("joint_v", rows_, vb.data());
     write_row("joint_a", rows_, ab.data());
     write_row("joint_tau", rows_, s.tau.data());
+    const std::vector<Vec3> jp = joint_positions(model_, s.q);
+    std::vector<double> flat;
+    for (const Vec3& p : jp) flat.insert(flat.end(), {p[0], p[1], p[2]});
+    write_row("joint_position", rows_, flat.data());
   } else {
     const double z = 0.0;
-    for (const char* k : {"joint_q", "joint_v", "joint_a", "joint_tau"}) write_row(k, rows_, &z);
+    for (const char* k : {"joint_q", "joint_v", "joint_a", "joint_tau", "joint_position"}) write_row(k, rows_, &z);
   }
-  const Vec6 tip = tip_motion(model_, s.q);
-  write_row("tip", rows_, tip.data());
-  const Vec3 p = tip_position(model_, s.q);
-  write_row("tip_position", rows_, p.data());
-  const Eigen::Vector3d u = tip_deflection(model_, s.q);
-  write_row("tip_deflection", rows_, u.data());
   const double total = s.energy.kinetic + s.energy.elastic + s.energy.gravity;
   const double e[6] = {s.energy.kinetic, s.energy.elastic, s.energy.gravity, s.input_work, s.dissipated,
                        total + s.dissipated - s.input_work};
@@ -275,11 +312,33 @@ void RunGroup::append(const OutputSample& s) {
   const double mom[6] = {s.momentum.linear.x(),  s.momentum.linear.y(),  s.momentum.linear.z(),
                          s.momentum.angular.x(), s.momentum.angular.y(), s.momentum.angular.z()};
   write_row("momentum", rows_, mom);
-  if (flexible_every_ > 0 && model_.n() > 0 && rows_ % flexible_every_ == 0) {
-    write_row("flexible_time", flex_rows_, &s.t);
-    write_row("flexible_q", flex_rows_, s.q.data());
-    ++flex_rows_;
+  write_row("centre_of_mass", rows_, s.momentum.centre.data());
+  const bool flexible_row = flexible_every_ > 0 && model_.n() > 0 && rows_ % flexible_every_ == 0;
+  if (flexible_row) write_row("flexible_time", flex_rows_, &s.t);
+  for (int l = 0; l < static_cast<int>(model_.links.size()); ++l) {
+    const MountedLink& L = model_.links[l];
+    const std::string g = "links/" + L.name + "/";
+    const Vec6 tip = tip_motion(model_, l, s.q);
+    write_row(g + "tip", rows_, tip.data());
+    const Vec3 p = tip_position(model_, l, s.q);
+    write_row(g + "tip_position", rows_, p.data());
+    const Eigen::Vector3d u = tip_deflection(model_, l, s.q);
+    write_row(g + "tip_deflection", rows_, u.data());
+    if (!L.d.payloads.empty()) {
+      std::vector<double> flat;
+      for (const Payload& pl : L.d.payloads) {
+        const Vec3 x = point_position(model_, l, pl.at, s.q);
+        flat.insert(flat.end(), {x[0], x[1], x[2]});
+      }
+      write_row(g + "payload_position", rows_, flat.data());
+    }
+    if (flexible_row && L.n() > 0) {
+      VecX ql(6 * L.n());
+      for (int k = 0; k < L.n(); ++k) ql.segment<6>(6 * k) = s.q.segment<6>(model_.rfe_index(l, k));
+      write_row(g + "flexible_q", flex_rows_, ql.data());
+    }
   }
+  if (flexible_row) ++flex_rows_;
   ++rows_;
   // Flush at most twice a second: output must not dominate a run, yet little is lost on a crash
   // and a watching reader sees the run advance.

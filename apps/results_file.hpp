@@ -87,9 +87,9 @@ class ResultsFile {
   std::vector<Pending> pending_;
 };
 
-/// Tip deflections in the paper's notation for the run's flexible link: u1 along y of {r} (in the
-/// plane of joints 2 and 3 for the paper's manipulator), u2 along z, θ the torsion φ1 of rfe_n.
-Eigen::Vector3d tip_deflection(const Model& model, const VecX& q);
+/// Tip deflections in the paper's notation for flexible link l: u1 along y of {r} (in the plane of
+/// joints 2 and 3 for the paper's manipulator), u2 along z, θ the torsion φ1 of rfe_n.
+Eigen::Vector3d tip_deflection(const Model& model, int l, const VecX& q);
 
 /// Writes an attribute on any HDF5 object (strings as variable-length UTF-8).
 void write_attribute(hid_t obj, const std::string& key, const std::string& value);

@@ -9,10 +9,17 @@
 
 namespace rfem::app {
 
+/// Peaks over a run of one link's tip deflections (tip_deflection).
+struct LinkPeaks {
+  std::string name;
+  double u1 = 0, u2 = 0, theta = 0;
+};
+
 struct RunSummary {
   std::string name, status;
   bool completed = false;
-  double wall = 0, t_reached = 0, peak_u1 = 0, peak_u2 = 0, peak_theta = 0, energy_drift = 0, energy_scale = 0;
+  double wall = 0, t_reached = 0, energy_drift = 0, energy_scale = 0;
+  std::vector<LinkPeaks> peaks;  ///< per link (empty without links)
   IntegratorStats stats;
   long samples = 0;
 };

@@ -12,12 +12,23 @@ int Parallelism::team(int n) const {
   return threads > 0 ? threads : omp_get_max_threads();
 }
 
-int Workspace::chunks(int n) {
-  const int c = (n + parallel.chunk - 1) / parallel.chunk;
+int Workspace::chunks(const Model& model) {
+  chunk.clear();
+  for (size_t l = 0; l < model.links.size(); ++l) {
+    const int n = model.links[l].n();
+    for (int k = 0; k < n; k += parallel.chunk) chunk.push_back({static_cast<int>(l), k, std::min(n, k + parallel.chunk)});
+  }
+  const int c = static_cast<int>(chunk.size());
   moments.assign(c, BaseMoments{});
   power.assign(c, 0.0);
   boundary.assign(c, Vec6::Zero());
   return c;
+}
+
+bool sdes_damped(const Model& model) {
+  for (const MountedLink& L : model.links)
+    if (L.d.damping_beta != 0.0) return true;
+  return false;
 }
 
 namespace {
@@ -42,105 +53,128 @@ Vec3 left_centre(const Discretisation& d, const Sde& e) {
   return e.left < 0 ? d.rfe0.centre : d.rfes[e.left].centre;
 }
 
-// Suffix sums over base links: moments of every body moved by joint j (links j … m and the
-// flexible link).
-std::vector<BaseMoments> suffix_moments(const Model& model, const BaseKinematics& bk,
-                                        const BaseMoments& flexible) {
-  const int m = model.m();
-  std::vector<BaseMoments> S(m + 1);
-  S[m] = flexible;
-  for (int i = m - 1; i >= 0; --i) {
-    const Mat4 WH = bk.W[i] * model.joints[i].H;
+// Suffix sums over the tree: S[i] = the moments of every body node i moves — its own, the links on
+// it (`link`: their rfes' moments) and its subtree's. Children come after their parents.
+void suffix_moments(const Model& model, const BaseKinematics& bk, const std::vector<BaseMoments>& link,
+                    std::vector<BaseMoments>& S) {
+  const int N = static_cast<int>(model.nodes.size());
+  S.assign(N, BaseMoments{});
+  for (size_t l = 0; l < model.links.size(); ++l)
+    if (model.links[l].parent >= 0) S[model.links[l].parent] += link[l];
+  for (int i = N - 1; i >= 0; --i) {
+    const Mat4 WH = bk.W[i] * model.nodes[i].H;
     BaseMoments b;
     b.Y = WH * bk.Wdd[i].transpose();
     b.G = WH * bk.W[i].transpose();
     b.s = WH.col(3);
-    S[i] = S[i + 1];
     S[i] += b;
+    if (model.nodes[i].parent >= 0) S[model.nodes[i].parent] += S[i];
   }
-  return S;
 }
 
-void base_kin(const Model& model, const VecX& q, const VecX& v, const VecX& a, BaseKinematics& bk) {
-  base_kinematics(model, base_coords(model, q), base_coords(model, v), base_coords(model, a), bk);
+// Each link's rfe moments, summed over its chunks in chunk order.
+std::vector<BaseMoments> link_moments(const Model& model, const Workspace& ws) {
+  std::vector<BaseMoments> flex(model.links.size());
+  for (size_t c = 0; c < ws.chunk.size(); ++c) flex[ws.chunk[c].link] += ws.moments[c];
+  return flex;
 }
 
 }  // namespace
 
-void generalised_forces(const Model& model, const VecX& q, const VecX& v, const VecX& a,
-                        const ForceTerms& terms, VecX& F, double* dissipation, Workspace* wsp) {
+void generalised_forces(const Model& model, const VecX& q, const VecX& v, const VecX& a, const ForceTerms& terms,
+                        VecX& F, double* dissipation, Workspace* wsp) {
   Workspace local;
   Workspace& ws = wsp ? *wsp : local;
-  const int n = model.n(), m = model.m();
-  const Discretisation& d = model.link;
-  const double g = terms.gravity ? model.gravity : 0.0, beta = d.damping_beta;
+  const double g = terms.gravity ? model.gravity : 0.0;
   F.resize(model.dof());
+  F.tail(model.dof() - model.chain_dofs()).setZero();  // carrying rfes and joints: sums below
   if (!terms.velocity_products && ws.zero.size() != model.dof()) ws.zero = VecX::Zero(model.dof());
   const VecX& vi = terms.velocity_products ? v : ws.zero;  // velocity seen by the inertial terms
   BaseKinematics& bk = ws.bk;
-  base_kin(model, q, vi, a, bk);
-  const int nchunks = ws.chunks(n);
+  base_kinematics(model, q, vi, a, bk);
+  const int nchunks = ws.chunks(model);
   // One pass per chunk: rfe k's pose and forces, then sde k (rfes k−1, k) with both rotations —
   // each rotation is evaluated once, except the one of the rfe before the chunk.
-#pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(n))
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(model.n()))
   for (int c = 0; c < nchunks; ++c) {
+    const Workspace::Chunk ch = ws.chunk[c];
+    const MountedLink& L = model.links[ch.link];
+    const Discretisation& d = L.d;
+    const LinkFrame& fr = bk.frame[ch.link];
     DeformationTransform dt;
-    const int k0 = ws.chunk_begin(c), k1 = ws.chunk_end(c, n);
-    RfeRotation left = k0 > 0 ? rotation_of(rfe_coords(model, q, k0 - 1)) : clamp_rotation();
+    RfeRotation left = ch.begin > 0 ? rotation_of(rfe_coords(model, q, ch.link, ch.begin - 1)) : clamp_rotation();
     BaseMoments& mom = ws.moments[c];
-    const Mat3 R0 = bk.B0.topLeftCorner<3, 3>();
-    for (int k = k0; k < k1; ++k) {
+    const Mat3 R0 = fr.B0.topLeftCorner<3, 3>();
+    for (int k = ch.begin; k < ch.end; ++k) {
+      if (L.carries(k)) continue;  // a node's body; its sdes come after the loop
       const Rfe& rfe = d.rfes[k];
-      const Vec6 qk = rfe_coords(model, q, k);
+      const int ik = model.rfe_index(ch.link, k);
+      const Vec6 qk = q.segment<6>(ik);
       deformation_transform(qk, dt, false);
-      const Vec3 p = bk.B0.topLeftCorner<3, 3>() * (rfe.centre + qk.head<3>()) + bk.B0.topRightCorner<3, 1>();
+      const Vec3 p = fr.B0.topLeftCorner<3, 3>() * (rfe.centre + qk.head<3>()) + fr.B0.topRightCorner<3, 1>();
       Vec6 f = Vec6::Zero();
       if (terms.inertia) {
         Vec3 fi, ni;
-        rfe_inertia(rfe, bk, dt, rfe_coords(model, vi, k), rfe_coords(model, a, k), p, f, fi, ni);
+        rfe_inertia(rfe, fr, dt, vi.segment<6>(ik), a.segment<6>(ik), p, f, fi, ni);
         mom.f += fi;
         mom.n += ni;
       }
       f.head<3>() += g * rfe.mass * R0.row(2).transpose();  // gravity on the mass centre
       mom.s += rfe.mass * Vec4(p[0], p[1], p[2], 1.0);
-      F.segment<6>(model.rfe_index(k)) = f;
+      F.segment<6>(ik) = f;
       const RfeRotation right = rfe_rotation(dt);
-      if (terms.sde) {
+      if (terms.sde && !(k > 0 && L.carries(k - 1))) {
         const Sde& e = d.sdes[k];
         SdeResult r;
-        sde_forces(e, left_centre(d, e), rfe.centre, beta, left_coords(model, q, k), left_coords(model, v, k), qk,
-                   rfe_coords(model, v, k), left, right, r);
-        if (k == k0) {
+        sde_forces(e, left_centre(d, e), rfe.centre, d.damping_beta, left_coords(model, q, ch.link, k),
+                   left_coords(model, v, ch.link, k), qk, v.segment<6>(ik), left, right, r);
+        if (k == ch.begin) {
           if (k > 0) ws.boundary[c] = r.f.head<6>();  // rfe k−1 belongs to the previous chunk
         } else {
-          F.segment<6>(model.rfe_index(k - 1)) += r.f.head<6>();
+          F.segment<6>(model.rfe_index(ch.link, k - 1)) += r.f.head<6>();
         }
-        F.segment<6>(model.rfe_index(k)) += r.f.tail<6>();
+        F.segment<6>(ik) += r.f.tail<6>();
         ws.power[c] += r.P_d;
       }
       left = right;
     }
   }
-  BaseMoments flex;
   double Pd = 0.0;
   for (int c = 0; c < nchunks; ++c) {
-    if (c > 0 && terms.sde) F.segment<6>(model.rfe_index(ws.chunk_begin(c) - 1)) += ws.boundary[c];
-    flex += ws.moments[c];
+    const Workspace::Chunk& ch = ws.chunk[c];
+    if (ch.begin > 0 && terms.sde) F.segment<6>(model.rfe_index(ch.link, ch.begin - 1)) += ws.boundary[c];
     Pd += ws.power[c];
   }
-  const auto S = suffix_moments(model, bk, flex);
-  for (int j = 0; j < m; ++j) {
-    const Mat4& X = bk.Xi[j];
+  if (terms.sde)
+    for (size_t l = 0; l < model.links.size(); ++l) {
+      const int li = static_cast<int>(l);
+      const Discretisation& d = model.links[l].d;
+      for (int e : model.links[l].carrier_sdes) {
+        SdeResult r;
+        const int ie = model.rfe_index(li, e);
+        sde_forces(d.sdes[e], left_centre(d, d.sdes[e]), d.rfes[e].centre, d.damping_beta, left_coords(model, q, li, e),
+                   left_coords(model, v, li, e), q.segment<6>(ie), v.segment<6>(ie), r);
+        if (e > 0) F.segment<6>(model.rfe_index(li, e - 1)) += r.f.head<6>();
+        F.segment<6>(ie) += r.f.tail<6>();
+        Pd += r.P_d;
+      }
+    }
+  suffix_moments(model, bk, link_moments(model, ws), ws.node_moments);
+  const std::vector<BaseMoments>& S = ws.node_moments;
+  for (size_t i = 0; i < model.nodes.size(); ++i) {
+    const Node& nd = model.nodes[i];
+    const Mat4& X = bk.Xi[i];
     double eps = 0.0;
-    if (terms.inertia)  // rigid links through Y; the rfes through their wrench and joint j's unit twist
-      eps = trace_prod(X, S[j].Y) + Vec3(X(2, 1), X(0, 2), X(1, 0)).dot(flex.n) + X.topRightCorner<3, 1>().dot(flex.f);
-    F[model.joint_index(j)] = eps + g * (X * S[j].s)[2];
-    const JointDrive& dr = model.joints[j].drive;
+    if (terms.inertia)  // rigid bodies through Y; the rfes through their wrench and the node's unit twist
+      eps = trace_prod(X, S[i].Y) + Vec3(X(2, 1), X(0, 2), X(1, 0)).dot(S[i].n) + X.topRightCorner<3, 1>().dot(S[i].f);
+    F[nd.coord] += eps + g * (X * S[i].s)[2];
+    if (nd.joint < 0) continue;
+    const JointDrive& dr = model.joints[nd.joint].drive;
     if (!dr.active()) continue;
-    const double vj = v[model.joint_index(j)];
-    if (terms.inertia) F[model.joint_index(j)] += dr.inertia * a[model.joint_index(j)];
+    const double vj = v[nd.coord];
+    if (terms.inertia) F[nd.coord] += dr.inertia * a[nd.coord];
     if (terms.sde) {
-      F[model.joint_index(j)] += dr.dissipative_force(vj);
+      F[nd.coord] += dr.dissipative_force(vj);
       Pd += dr.power(vj);
     }
   }
@@ -152,14 +186,29 @@ namespace {
 using RowMat6 = Eigen::Matrix<double, 6, 6, Eigen::RowMajor>;
 using Block = Eigen::Map<RowMat6>;
 
-// Adds sde e's 12×12 matrix f·A (coordinates [rfe e−1; rfe e]) to `vals`: D_e, E_e and D_{e−1}
-// (into *left instead when given: that rfe belongs to another chunk).
-void scatter_sde(const BorderedPattern& p, int e, const Mat12& A, std::vector<double>& vals, Mat6* left) {
-  Block(vals.data() + p.diag(e)) += A.bottomRightCorner<6, 6>();
-  if (e == 0) return;
-  Block(vals.data() + p.coupling(e)) += A.topRightCorner<6, 6>();
+// Adds sde e's 12×12 matrix A (coordinates [rfe e−1; rfe e], both in one chain, block b for rfe e)
+// to `vals`: D_b, E_b and D_{b−1} (into *left instead when given: that rfe belongs to another chunk).
+void scatter_sde(const BorderedPattern& p, int b, bool has_left, const Mat12& A, std::vector<double>& vals, Mat6* left) {
+  Block(vals.data() + p.diag(b)) += A.bottomRightCorner<6, 6>();
+  if (!has_left) return;
+  Block(vals.data() + p.coupling(b)) += A.topRightCorner<6, 6>();
   if (left) *left = A.topLeftCorner<6, 6>();
-  else Block(vals.data() + p.diag(e - 1)) += A.topLeftCorner<6, 6>();
+  else Block(vals.data() + p.diag(b - 1)) += A.topLeftCorner<6, 6>();
+}
+
+// Adds a symmetric matrix over the coordinates of rfes `rfes` (each 6, unknown index = coordinate)
+// to the pattern's upper triangle, entry by entry (an sde at a carrying rfe: chain blocks, their
+// border columns and the border block alike).
+template <int K>
+void scatter_entries(const BorderedPattern& p, const int (&first)[K], const Eigen::Matrix<double, 6 * K, 6 * K>& A,
+                     std::vector<double>& vals) {
+  for (int X = 0; X < K; ++X)
+    for (int Y = 0; Y < K; ++Y)
+      for (int a = 0; a < 6; ++a)
+        for (int b = 0; b < 6; ++b) {
+          const int r = first[X] + a, c = first[Y] + b;
+          if (r <= c) vals[p.slot(r, c)] += A(6 * X + a, 6 * Y + b);
+        }
 }
 
 }  // namespace
@@ -169,91 +218,160 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
                        const std::vector<SdeTarget>& extra, MatX* base_rows, Workspace* wsp) {
   Workspace local;
   Workspace& ws = wsp ? *wsp : local;
-  const int n = model.n(), m = model.m(), nb = pattern.n_base(), ne = static_cast<int>(extra.size());
-  const Discretisation& d = model.link;
+  const int N = static_cast<int>(model.nodes.size()), m = model.m(), nb = pattern.n_base(),
+            ne = static_cast<int>(extra.size()), n6 = model.chain_dofs();
   values.assign(pattern.nnz(), 0.0);
   for (const auto& x : extra) x.values->assign(pattern.nnz(), 0.0);
   if (ws.zero.size() != model.dof()) ws.zero = VecX::Zero(model.dof());
   const VecX& zero = ws.zero;
   BaseKinematics& bk = ws.bk;
-  base_kin(model, q, v, zero, bk);
+  base_kinematics(model, q, v, zero, bk);
   const double g = t.gravity ? model.gravity : 0.0;
   const bool sdes = t.stiffness != 0.0 || t.damping != 0.0 || ne > 0;
-  bool damping = d.damping_beta != 0.0 && t.damping != 0.0;
-  for (const auto& x : extra) damping |= d.damping_beta != 0.0 && x.fc != 0.0;
+  bool any_damping = t.damping != 0.0;
+  for (const auto& x : extra) any_damping |= x.fc != 0.0;
   const bool second = sdes || t.inertial;  // the geometric stiffness and the centrifugal one need ∂²R
-  const int nchunks = ws.chunks(n);
+  const int nchunks = ws.chunks(model);
   ws.boundary_block.assign(static_cast<size_t>(nchunks) * (1 + ne), Mat6::Zero());
   if (base_rows) base_rows->setZero(m, pattern.size());
-  std::vector<int> col(m);  // joint → border column (−1 if held)
-  for (int j = 0; j < m; ++j) col[j] = base_col[j] >= 0 ? base_col[j] - model.flexible_dofs() : -1;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(n))
+  // Each node's unknown index (−1: a held joint) and border column.
+  std::vector<int> unknown(N), col(N);
+  for (int i = 0; i < N; ++i) {
+    const Node& nd = model.nodes[i];
+    unknown[i] = nd.joint >= 0 ? base_col[nd.joint] : nd.coord;
+    col[i] = unknown[i] >= 0 ? unknown[i] - n6 : -1;
+  }
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(model.n()))
   for (int c = 0; c < nchunks; ++c) {
+    const Workspace::Chunk ch = ws.chunk[c];
+    const MountedLink& L = model.links[ch.link];
+    const Discretisation& d = L.d;
+    const LinkFrame& fr = bk.frame[ch.link];
+    const std::vector<int>& anc = L.ancestors;
+    const bool damping = d.damping_beta != 0.0 && any_damping;
     RfePose pose;
     Mat6 Mkk;
     MatX border, gb;
     Mat4 G;
     Mat12 Ke, Ce, A;
     DeformationTransform left;  // the rfe before, for the sde between them
-    const int k0 = ws.chunk_begin(c);
-    if (sdes) deformation_transform(k0 > 0 ? rfe_coords(model, q, k0 - 1) : Vec6::Zero().eval(), left, true);
-    for (int k = k0; k < ws.chunk_end(c, n); ++k) {
+    if (sdes)
+      deformation_transform(ch.begin > 0 ? rfe_coords(model, q, ch.link, ch.begin - 1) : Vec6::Zero().eval(), left, true);
+    for (int k = ch.begin; k < ch.end; ++k) {
+      if (L.carries(k)) continue;  // a node's body; its sdes come after the loop
       const Rfe& rfe = d.rfes[k];
-      rfe_pose(rfe, bk, rfe_coords(model, q, k), rfe_coords(model, v, k), rfe_coords(model, zero, k), pose, t.inertial, second);
-      rfe_mass_blocks(rfe, pose, bk, Mkk, border, G);
+      const int ik = model.rfe_index(ch.link, k), b = ik / Model::rfe_dofs;
+      rfe_pose(rfe, fr, q.segment<6>(ik), v.segment<6>(ik), zero.segment<6>(ik), pose, t.inertial, second);
+      rfe_mass_blocks(rfe, pose, bk.Xi, anc, Mkk, border, G);
       ws.moments[c].G += G;
       ws.moments[c].s += pose.W * rfe.H.col(3);
       Mat6 blk = t.mass * Mkk;
       border *= t.mass;
-      if (base_rows) base_rows->middleCols<6>(model.rfe_index(k)) = border;
-      if (t.inertial) blk += t.stiffness * rfe_inertial_stiffness(rfe, pose, bk);
+      if (base_rows)
+        for (size_t r = 0; r < anc.size(); ++r)
+          if (model.nodes[anc[r]].joint >= 0) base_rows->row(model.nodes[anc[r]].joint).segment<6>(ik) = border.row(r);
+      if (t.inertial) blk += t.stiffness * rfe_inertial_stiffness(rfe, pose, fr);
       if (g != 0.0) {
-        gb.setZero(m, 6);
-        rfe_gravity_border(rfe, pose, bk, g, gb);
+        gb.setZero(anc.size(), 6);
+        rfe_gravity_border(rfe, pose, bk.Xi, anc, g, gb);
         border += t.stiffness * gb;
       }
-      Block(values.data() + pattern.diag(k)) = blk;
-      for (int j = 0; j < m; ++j)
-        if (col[j] >= 0)
-          for (int l = 0; l < 6; ++l) values[pattern.border(k) + static_cast<long>(l) * nb + col[j]] = border(j, l);
+      Block(values.data() + pattern.diag(b)) = blk;
+      const long w = pattern.width(b);
+      for (size_t r = 0; r < anc.size(); ++r) {
+        if (col[anc[r]] < 0) continue;
+        const long at = pattern.border(b) + pattern.border_pos(b, col[anc[r]]);
+        for (int l = 0; l < 6; ++l) values[at + l * w] = border(r, l);
+      }
       if (!sdes) continue;
+      if (k > 0 && L.carries(k - 1)) {  // (that sde comes after the loop)
+        left = pose.d;
+        continue;
+      }
       const Sde& e = d.sdes[k];
-      sde_matrices(e, left_centre(d, e), rfe.centre, d.damping_beta, left_coords(model, q, k), rfe_coords(model, q, k), left, pose.d,
-                   Ke, damping ? &Ce : nullptr);
-      const bool first = k == k0 && k > 0;  // its left rfe belongs to the previous chunk
+      sde_matrices(e, left_centre(d, e), rfe.centre, d.damping_beta, left_coords(model, q, ch.link, k), q.segment<6>(ik),
+                   left, pose.d, Ke, damping ? &Ce : nullptr);
+      const bool first = k == ch.begin && k > 0;  // its left rfe belongs to the previous chunk
       const size_t bslot = static_cast<size_t>(c) * (1 + ne);
       A = t.stiffness * Ke;
       if (damping) A += t.damping * Ce;
-      scatter_sde(pattern, k, A, values, first ? &ws.boundary_block[bslot] : nullptr);
+      scatter_sde(pattern, b, k > 0, A, values, first ? &ws.boundary_block[bslot] : nullptr);
       for (int i = 0; i < ne; ++i) {
         A = extra[i].fk * Ke;
         if (damping) A += extra[i].fc * Ce;
-        scatter_sde(pattern, k, A, *extra[i].values, first ? &ws.boundary_block[bslot + 1 + i] : nullptr);
+        scatter_sde(pattern, b, k > 0, A, *extra[i].values, first ? &ws.boundary_block[bslot + 1 + i] : nullptr);
       }
       left = pose.d;
     }
   }
   if (sdes)
-    for (int c = 1; c < nchunks; ++c) {
-      const int k = ws.chunk_begin(c) - 1;
+    for (int c = 0; c < nchunks; ++c) {
+      const Workspace::Chunk& ch = ws.chunk[c];
+      if (ch.begin == 0 || model.links[ch.link].carries(ch.begin - 1)) continue;
+      const int b = model.rfe_index(ch.link, ch.begin - 1) / Model::rfe_dofs;
       const size_t bslot = static_cast<size_t>(c) * (1 + ne);
-      Block(values.data() + pattern.diag(k)) += ws.boundary_block[bslot];
-      for (int i = 0; i < ne; ++i) Block(extra[i].values->data() + pattern.diag(k)) += ws.boundary_block[bslot + 1 + i];
+      Block(values.data() + pattern.diag(b)) += ws.boundary_block[bslot];
+      for (int i = 0; i < ne; ++i) Block(extra[i].values->data() + pattern.diag(b)) += ws.boundary_block[bslot + 1 + i];
     }
-  BaseMoments flex;
-  for (const auto& c : ws.moments) flex += c;
-  const auto S = suffix_moments(model, bk, flex);
-  for (int j = 0; j < m; ++j)
-    for (int l = 0; l < m; ++l) {
-      if (col[l] < 0) continue;  // columns are unknowns only
-      const int hi = std::max(j, l);
+  // Carrying rfes: the sdes at their ends, and (on request) their own centrifugal stiffness.
+  for (size_t l = 0; l < model.links.size(); ++l) {
+    const int li = static_cast<int>(l);
+    const MountedLink& L = model.links[l];
+    const Discretisation& d = L.d;
+    const bool damping = d.damping_beta != 0.0 && any_damping;
+    if (sdes)
+      for (int e : L.carrier_sdes) {
+        Mat12 Ke, Ce, A;
+        sde_matrices(d.sdes[e], left_centre(d, d.sdes[e]), d.rfes[e].centre, d.damping_beta, left_coords(model, q, li, e),
+                     rfe_coords(model, q, li, e), Ke, damping ? &Ce : nullptr);
+        if (e == 0) {  // rfe_0 is rigid with {r}: only rfe e's block
+          const int first[1] = {model.rfe_index(li, e)};
+          Mat6 B = t.stiffness * Ke.bottomRightCorner<6, 6>();
+          if (damping) B += t.damping * Ce.bottomRightCorner<6, 6>();
+          scatter_entries<1>(pattern, first, B, values);
+          for (const auto& x : extra) {
+            B = x.fk * Ke.bottomRightCorner<6, 6>();
+            if (damping) B += x.fc * Ce.bottomRightCorner<6, 6>();
+            scatter_entries<1>(pattern, first, B, *x.values);
+          }
+          continue;
+        }
+        const int first[2] = {model.rfe_index(li, e - 1), model.rfe_index(li, e)};
+        A = t.stiffness * Ke;
+        if (damping) A += t.damping * Ce;
+        scatter_entries<2>(pattern, first, A, values);
+        for (const auto& x : extra) {
+          A = x.fk * Ke;
+          if (damping) A += x.fc * Ce;
+          scatter_entries<2>(pattern, first, A, *x.values);
+        }
+      }
+    if (t.inertial && t.stiffness != 0.0)
+      for (int k = 0; k < L.n(); ++k) {
+        if (!L.carries(k)) continue;
+        RfePose pose;
+        const int ik = model.rfe_index(li, k);
+        rfe_pose(d.rfes[k], bk.frame[l], q.segment<6>(ik), v.segment<6>(ik), zero.segment<6>(ik), pose, true, true);
+        const int first[1] = {ik};
+        const Mat6 B = t.stiffness * rfe_inertial_stiffness(d.rfes[k], pose, bk.frame[l]);
+        scatter_entries<1>(pattern, first, B, values);
+      }
+  }
+  suffix_moments(model, bk, link_moments(model, ws), ws.node_moments);
+  const std::vector<BaseMoments>& S = ws.node_moments;
+  for (int j = 0; j < N; ++j)
+    for (int l = 0; l < N; ++l) {
+      if (unknown[l] < 0) continue;  // columns are unknowns only
+      const int lo = std::min(j, l), hi = std::max(j, l);
+      if (!model.ancestor(lo, hi)) continue;  // no body moves with both
+      const int jj = model.nodes[j].joint;
       double mass = t.mass * trace_prod(bk.Xi[j] * S[hi].G, bk.Xi[l].transpose());
-      if (j == l) mass += t.mass * model.joints[j].drive.inertia;
-      if (base_rows) (*base_rows)(j, base_col[l]) = mass;
+      if (j == l && jj >= 0) mass += t.mass * model.joints[jj].drive.inertia;
+      if (base_rows && jj >= 0) (*base_rows)(jj, unknown[l]) = mass;
       if (col[j] < 0 || l < j) continue;
       double val = mass;
-      if (g != 0.0) val += t.stiffness * g * (bk.Xi[j] * bk.Xi[l] * S[hi].s)[2];
-      if (j == l && t.damping != 0.0) val += t.damping * model.joints[j].drive.damping_derivative(v[model.joint_index(j)]);
+      if (g != 0.0) val += t.stiffness * g * (bk.Xi[lo] * bk.Xi[hi] * S[hi].s)[2];
+      if (j == l && jj >= 0 && t.damping != 0.0) val += t.damping * model.joints[jj].drive.damping_derivative(v[model.nodes[j].coord]);
       values[pattern.base() + static_cast<long>(std::min(col[j], col[l])) * nb + std::max(col[j], col[l])] += val;
     }
 }
@@ -266,32 +384,38 @@ void assemble_matrix(const Model& model, const BorderedPattern& pattern, const s
 Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* wsp) {
   Workspace local;
   Workspace& ws = wsp ? *wsp : local;
-  const int n = model.n(), m = model.m();
-  const Discretisation& d = model.link;
   Energies E;
   if (ws.zero.size() != model.dof()) ws.zero = VecX::Zero(model.dof());
   BaseKinematics& bk = ws.bk;
-  base_kin(model, q, v, ws.zero, bk);
-  for (int i = 0; i < m; ++i) {
-    const Mat4& H = model.joints[i].H;
-    E.kinetic += 0.5 * trace_prod(bk.Wd[i] * H, bk.Wd[i].transpose());
-    E.gravity += model.gravity * (bk.W[i] * H.col(3))[2];
-    const double vi = v[model.joint_index(i)];
-    E.kinetic += model.joints[i].drive.kinetic_energy(vi);
-    E.dissipation_rate += model.joints[i].drive.power(vi);
+  base_kinematics(model, q, v, ws.zero, bk);
+  for (size_t i = 0; i < model.nodes.size(); ++i) {
+    const Node& nd = model.nodes[i];
+    E.kinetic += 0.5 * trace_prod(bk.Wd[i] * nd.H, bk.Wd[i].transpose());
+    E.gravity += model.gravity * (bk.W[i] * nd.H.col(3))[2];
+    if (nd.joint < 0) continue;
+    const double vi = v[nd.coord];
+    E.kinetic += model.joints[nd.joint].drive.kinetic_energy(vi);
+    E.dissipation_rate += model.joints[nd.joint].drive.power(vi);
   }
-  const int nchunks = ws.chunks(n);
+  const int nchunks = ws.chunks(model);
   std::vector<Eigen::Vector4d> part(nchunks, Eigen::Vector4d::Zero());  // T, V_g, V_e, P_d per chunk
-#pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(n))
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(model.n()))
   for (int c = 0; c < nchunks; ++c) {
+    const Workspace::Chunk ch = ws.chunk[c];
+    const MountedLink& L = model.links[ch.link];
+    const Discretisation& d = L.d;
     RfePose pose;
-    for (int k = ws.chunk_begin(c); k < ws.chunk_end(c, n); ++k) {
-      rfe_pose(d.rfes[k], bk, rfe_coords(model, q, k), rfe_coords(model, v, k), rfe_coords(model, ws.zero, k), pose, false);
-      const Sde& s = d.sdes[k];
+    for (int k = ch.begin; k < ch.end; ++k) {
+      if (L.carries(k)) continue;
+      const int ik = model.rfe_index(ch.link, k);
+      rfe_pose(d.rfes[k], bk.frame[ch.link], q.segment<6>(ik), v.segment<6>(ik), ws.zero.segment<6>(ik), pose, false);
       SdeResult r;
-      sde_forces(s, left_centre(d, s), d.rfes[k].centre, d.damping_beta, left_coords(model, q, k), left_coords(model, v, k),
-                 rfe_coords(model, q, k), rfe_coords(model, v, k), r);
-      part[c] += Eigen::Vector4d(rfe_kinetic_energy(d.rfes[k], pose, bk, rfe_coords(model, v, k)),
+      if (!(k > 0 && L.carries(k - 1))) {
+        const Sde& s = d.sdes[k];
+        sde_forces(s, left_centre(d, s), d.rfes[k].centre, d.damping_beta, left_coords(model, q, ch.link, k),
+                   left_coords(model, v, ch.link, k), q.segment<6>(ik), v.segment<6>(ik), r);
+      }
+      part[c] += Eigen::Vector4d(rfe_kinetic_energy(d.rfes[k], pose, bk.frame[ch.link], v.segment<6>(ik)),
                                  model.gravity * (pose.W * d.rfes[k].H.col(3))[2], r.V, r.P_d);
     }
   }
@@ -301,6 +425,17 @@ Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* w
   E.gravity += sum[1];
   E.elastic = sum[2];
   E.dissipation_rate += sum[3];
+  for (size_t l = 0; l < model.links.size(); ++l) {  // sdes at carrying rfes
+    const int li = static_cast<int>(l);
+    const Discretisation& d = model.links[l].d;
+    for (int e : model.links[l].carrier_sdes) {
+      SdeResult r;
+      sde_forces(d.sdes[e], left_centre(d, d.sdes[e]), d.rfes[e].centre, d.damping_beta, left_coords(model, q, li, e),
+                 left_coords(model, v, li, e), rfe_coords(model, q, li, e), rfe_coords(model, v, li, e), r);
+      E.elastic += r.V;
+      E.dissipation_rate += r.P_d;
+    }
+  }
   return E;
 }
 

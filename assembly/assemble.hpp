@@ -1,9 +1,11 @@
 #pragma once
-// Global assembly over rfes and sdes (OpenMP), one parallel loop over fixed chunks of rfes
-// (assembly/workspace.hpp). A chunk evaluates its rfes and the sdes ending on them (sde e joins
+// Global assembly over rfes and sdes (OpenMP), one parallel loop over fixed chunks of every link's
+// rfes (assembly/workspace.hpp). A chunk evaluates its rfes and the sdes ending on them (sde e joins
 // rfes e−1 and e); the first sde's share of the previous chunk's last rfe is kept aside and added
 // after the loop, so no two threads write one slot, and partial sums are combined in chunk order:
-// results do not depend on the thread count.
+// results do not depend on the thread count. Rfes that carry a joint or a link are bodies of the
+// kinematic tree (core/model.hpp): the tree's pass after the loop gives their rows, and the few
+// sdes at their ends are assembled serially after the loop.
 #include "assembly/pattern.hpp"
 #include "assembly/workspace.hpp"
 #include "core/kinematics.hpp"
@@ -19,7 +21,7 @@ struct ForceTerms {
   bool velocity_products = true;
 };
 
-/// F = ε(q, v, a) + ∂V_g/∂q + ∂V_e/∂q + sde damping for all 6n + m coordinates (flexible first).
+/// F = ε(q, v, a) + ∂V_g/∂q + ∂V_e/∂q + sde damping for all 6n + m coordinates (model order).
 /// plus every joint drive's τ_drive (core/joint_drive.hpp). If `dissipation` is given, the power
 /// dissipated in the sdes and the drives [W] goes there (same pass).
 /// `ws` (may be null: a temporary one) holds the thread policy and scratch.
@@ -36,7 +38,8 @@ struct MatrixTerms {
   bool inertial = false;
 };
 
-/// Assembles S into `values` (pattern.nnz()); base_col[j] is joint j's column or −1 if held.
+/// Assembles S into `values` (pattern.nnz()); base_col[j] is joint j's unknown index (numbered
+/// after every rfe coordinate) or −1 if held; `pattern` is BorderedPattern(model, base_col).
 void assemble_matrix(const Model& model, const BorderedPattern& pattern, const std::vector<int>& base_col,
                      const VecX& q, const VecX& v, const MatrixTerms& terms, std::vector<double>& values,
                      Workspace* ws = nullptr);
@@ -60,12 +63,14 @@ struct Energies {
 };
 Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* ws = nullptr);
 
-/// Views of one rfe's coordinates in a full coordinate vector.
-inline Vec6 rfe_coords(const Model& model, const VecX& x, int k) { return x.segment<6>(model.rfe_index(k)); }
-/// Coordinates of the rfe left of sde e (zeros for rfe_0, which is rigid with {r}).
-inline Vec6 left_coords(const Model& model, const VecX& x, int e) {
-  return e > 0 ? rfe_coords(model, x, e - 1) : Vec6::Zero().eval();
+/// Views of rfe k of link l's coordinates in a full coordinate vector.
+inline Vec6 rfe_coords(const Model& model, const VecX& x, int l, int k) { return x.segment<6>(model.rfe_index(l, k)); }
+/// Coordinates of the rfe left of sde e of link l (zeros for rfe_0, which is rigid with {r}).
+inline Vec6 left_coords(const Model& model, const VecX& x, int l, int e) {
+  return e > 0 ? rfe_coords(model, x, l, e - 1) : Vec6::Zero().eval();
 }
+/// Whether any link's sdes are damped.
+bool sdes_damped(const Model& model);
 /// The base part of a full coordinate vector.
 inline VecX base_coords(const Model& model, const VecX& x) { return model.joint_coords(x); }
 

@@ -15,37 +15,47 @@ Vec3 vee_antisymmetric(const Mat3& A) { return Vec3(A(1, 2) - A(2, 1), A(2, 0) -
 Momentum momentum(const Model& model, const VecX& q, const VecX& v, Workspace* wsp) {
   Workspace local;
   Workspace& ws = wsp ? *wsp : local;
-  const int n = model.n(), m = model.m();
-  const Discretisation& d = model.link;
   if (ws.zero.size() != model.dof()) ws.zero = VecX::Zero(model.dof());
   BaseKinematics& bk = ws.bk;
-  base_kinematics(model, base_coords(model, q), base_coords(model, v), base_coords(model, ws.zero), bk);
+  base_kinematics(model, q, v, ws.zero, bk);
   Vec3 lin = Vec3::Zero();
   Mat3 A = Mat3::Zero();
-  for (int i = 0; i < m; ++i) {
-    const Mat4& H = model.joints[i].H;
+  Vec4 s = Vec4::Zero();  // ∫[x; 1] dm
+  for (size_t i = 0; i < model.nodes.size(); ++i) {
+    const Mat4& H = model.nodes[i].H;
     lin += (bk.Wd[i] * H.col(3)).head<3>();
     A += (bk.W[i] * H * bk.Wd[i].transpose()).topLeftCorner<3, 3>();
+    s += bk.W[i] * H.col(3);
   }
-  const int nchunks = ws.chunks(n);
+  const int nchunks = ws.chunks(model);
   std::vector<Eigen::Matrix<double, 3, 4>> part(nchunks, Eigen::Matrix<double, 3, 4>::Zero());  // [A | lin]
-#pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(n))
+  std::vector<Vec4> first(nchunks, Vec4::Zero());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(model.n()))
   for (int c = 0; c < nchunks; ++c) {
+    const Workspace::Chunk ch = ws.chunk[c];
+    const MountedLink& L = model.links[ch.link];
     RfePose pose;
     Vec3 l;
     Mat3 a;
-    for (int k = ws.chunk_begin(c); k < ws.chunk_end(c, n); ++k) {
-      rfe_pose(d.rfes[k], bk, rfe_coords(model, q, k), rfe_coords(model, v, k), rfe_coords(model, ws.zero, k), pose, false);
-      rfe_momentum_moments(d.rfes[k], pose, bk, rfe_coords(model, v, k), l, a);
+    for (int k = ch.begin; k < ch.end; ++k) {
+      if (L.carries(k)) continue;  // a node's body
+      const int ik = model.rfe_index(ch.link, k);
+      rfe_pose(L.d.rfes[k], bk.frame[ch.link], q.segment<6>(ik), v.segment<6>(ik), ws.zero.segment<6>(ik), pose, false);
+      rfe_momentum_moments(L.d.rfes[k], pose, bk.frame[ch.link], v.segment<6>(ik), l, a);
       part[c].leftCols<3>() += a;
       part[c].col(3) += l;
+      first[c] += pose.W * L.d.rfes[k].H.col(3);
     }
   }
-  for (const auto& p : part) {  // chunk order: the same bits for any thread count
-    A += p.leftCols<3>();
-    lin += p.col(3);
+  for (int c = 0; c < nchunks; ++c) {  // chunk order: the same bits for any thread count
+    A += part[c].leftCols<3>();
+    lin += part[c].col(3);
+    s += first[c];
   }
-  return Momentum{lin, vee_antisymmetric(A)};
+  Momentum out{lin, vee_antisymmetric(A)};
+  out.mass = s[3];
+  out.centre = s[3] > 0 ? Vec3(s.head<3>() / s[3]) : Vec3::Zero();
+  return out;
 }
 
 }  // namespace rfem

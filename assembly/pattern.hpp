@@ -1,43 +1,62 @@
 #pragma once
 // Storage of the bordered block matrix of the Newton system (FORMULATION.md §4), its upper
-// triangle block by block: for each rfe k (stride 72 + 6 nb values)
+// triangle block by block. The unknowns are 6-blocks (rfes) grouped into *chains* — runs of
+// consecutive blocks, each coupled to its neighbours (the rfes of one link between carrying rfes)
+// — followed by nb *border* coordinates (carrying rfes and unknown joints). Every block of chain c
+// is coupled to the same set of border columns cols_c (what its link's rfes depend on). Per block k
+// of chain c (stride 72 + 6 w_c, w_c = |cols_c|):
 //   D_k = S(k, k)     6×6, row-major (its upper triangle is the matrix; the lower is scratch),
-//   E_k = S(k−1, k)   6×6, row-major (rows of rfe k−1; unused for k = 0: rfe_0 is rigid),
-//   B_k = S(k, base)  6×nb, row-major,
-// then the base block Z (nb×nb, row-major, upper triangle). Coordinates are numbered rfes first,
-// base last, so the Cholesky factor has no fill beyond these blocks: the chain solver factorises
-// in place, and CHOLMOD receives the same entries in compressed columns (built on first use).
+//   E_k = S(k−1, k)   6×6, row-major (rows of block k−1; unused for a chain's first block),
+//   B_k = S(k, cols_c) 6×w_c, row-major,
+// then the border block Z (nb×nb, row-major, upper triangle). Eliminating a chain only updates
+// Z on cols_c × cols_c, which is dense anyway: the Cholesky factor has no fill beyond these blocks
+// in this order, so the chain solver factorises in place, and CHOLMOD receives the same entries
+// in compressed columns (built on first use).
 #include <mutex>
 #include <vector>
 
-#include "core/types.hpp"
+#include "core/model.hpp"
 
 namespace rfem {
 
 class BorderedPattern {
  public:
-  BorderedPattern(int n_rfes, int n_base);
-  int n_rfes() const { return n_; }
+  struct Chain {
+    int first = 0, count = 0;  ///< blocks first … first + count − 1
+    std::vector<int> cols;     ///< border columns of its blocks, ascending
+  };
+  /// One chain of n blocks bordered by all nb columns (one flexible link at the end of a chain).
+  BorderedPattern(int n_blocks, int n_base);
+  /// Chains covering blocks 0 … N−1 in order, and nb border columns.
+  BorderedPattern(std::vector<Chain> chains, int n_base);
+  /// The Newton matrix over a model's unknowns, numbered as EquationsOfMotion does: every rfe
+  /// coordinate in the model's order, then the joints with base_col[j] ≥ 0 (in that order). The
+  /// chains are each link's runs of rfes that carry nothing; the border holds the carrying rfes and
+  /// the unknown joints; a chain's columns are the unknown nodes that move its link and the
+  /// carrying rfes at its ends.
+  BorderedPattern(const Model& model, const std::vector<int>& base_col);
+
+  int n_blocks() const { return nblocks_; }
   int n_base() const { return nb_; }
-  int size() const { return 6 * n_ + nb_; }
+  int size() const { return 6 * nblocks_ + nb_; }
+  const std::vector<Chain>& chains() const { return chains_; }
+  int chain_of(int k) const { return chain_of_[k]; }
+  /// Border width of block k.
+  int width(int k) const { return static_cast<int>(chains_[chain_of_[k]].cols.size()); }
+  /// Whether block k is coupled to block k − 1 (the same chain).
+  bool coupled(int k) const { return k > 0 && chain_of_[k] == chain_of_[k - 1]; }
+  /// Position of border column `col` among block k's border columns, −1 if not coupled.
+  int border_pos(int k, int col) const { return pos_[chain_of_[k]][col]; }
   /// Values to store (the storage size, not the count of distinct entries).
-  long nnz() const { return stride_ * n_ + static_cast<long>(nb_) * nb_; }
-  /// Distinct entries of the upper triangle (21 + 36 + 6 nb per rfe, less rfe 1's coupling).
+  long nnz() const { return base() + static_cast<long>(nb_) * nb_; }
+  /// Distinct entries of the upper triangle.
   long entries() const;
-  long stride() const { return stride_; }
-  long diag(int k) const { return stride_ * k; }
-  long coupling(int k) const { return stride_ * k + 36; }
-  long border(int k) const { return stride_ * k + 72; }
-  long base() const { return stride_ * n_; }
-  /// Index into the value array of entry (r, c), r ≤ c, of the pattern.
-  long slot(int r, int c) const {
-    const int n6 = 6 * n_;
-    if (r >= n6) return base() + static_cast<long>(r - n6) * nb_ + (c - n6);
-    const int k = r / 6, a = r % 6;
-    if (c >= n6) return border(k) + static_cast<long>(a) * nb_ + (c - n6);
-    const int kc = c / 6, b = c % 6;
-    return kc == k ? diag(k) + 6 * a + b : coupling(kc) + 6 * a + b;  // kc = k + 1
-  }
+  long diag(int k) const { return offset_[k]; }
+  long coupling(int k) const { return offset_[k] + 36; }
+  long border(int k) const { return offset_[k] + 72; }
+  long base() const { return offset_[nblocks_]; }
+  /// Index into the value array of entry (r, c), r ≤ c, of the pattern; −1 if (r, c) is outside it.
+  long slot(int r, int c) const;
   /// y = S x for the symmetric matrix whose upper triangle is `values`.
   void multiply(const std::vector<double>& values, const VecX& x, VecX& y) const;
 
@@ -49,8 +68,12 @@ class BorderedPattern {
   const Csc& csc() const;
 
  private:
-  int n_, nb_;
-  long stride_;
+  void index();
+  std::vector<Chain> chains_;
+  int nblocks_ = 0, nb_ = 0;
+  std::vector<int> chain_of_;
+  std::vector<long> offset_;          // per block, then the border block's
+  std::vector<std::vector<int>> pos_;  // per chain: border column → position (−1)
   mutable std::once_flag csc_once_;
   mutable Csc csc_;
 };

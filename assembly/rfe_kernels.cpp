@@ -7,7 +7,7 @@ namespace {
 inline Mat34 lift(const Mat4& X, const Mat34& A) { return X.topLeftCorner<3, 3>() * A; }
 }  // namespace
 
-void rfe_pose(const Rfe& rfe, const BaseKinematics& bk, const Vec6& q, const Vec6& v, const Vec6& a,
+void rfe_pose(const Rfe& rfe, const LinkFrame& bk, const Vec6& q, const Vec6& v, const Vec6& a,
               RfePose& out, bool accelerations, bool second) {
   deformation_transform(q, out.d, accelerations || second);
   Mat4 P = out.d.D;
@@ -30,7 +30,7 @@ void rfe_inertial_force(const Rfe& rfe, const RfePose& p, Vec6& eps, Mat4& Y) {
   Y = p.W * rfe.H * Wdd4.transpose();
 }
 
-void rfe_inertia(const Rfe& rfe, const BaseKinematics& bk, const DeformationTransform& d, const Vec6& v,
+void rfe_inertia(const Rfe& rfe, const LinkFrame& bk, const DeformationTransform& d, const Vec6& v,
                  const Vec6& a, const Vec3& p, Vec6& eps, Vec3& f, Vec3& n) {
   const Mat3 R0 = bk.B0.topLeftCorner<3, 3>();
   const Mat3& Om = bk.Omega.topLeftCorner<3, 3>();
@@ -62,8 +62,8 @@ void rfe_gravity_force(const Rfe& rfe, const RfePose& p, double g, Vec6& f, Vec4
   s = p.W * rfe.H.col(3);
 }
 
-void rfe_mass_blocks(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, Mat6& Mkk,
-                     MatX& border, Mat4& G) {
+void rfe_mass_blocks(const Rfe& rfe, const RfePose& p, const std::vector<Mat4>& Xi, const std::vector<int>& ancestors,
+                     Mat6& Mkk, MatX& border, Mat4& G) {
   const Mat3 J = rfe.H.topLeftCorner<3, 3>();
   const Mat3 R = p.d.D.topLeftCorner<3, 3>();
   const Mat3 Ic = R * (J.trace() * Mat3::Identity() - J) * R.transpose();  // central inertia in {r}
@@ -73,11 +73,11 @@ void rfe_mass_blocks(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk,
   Mkk.topLeftCorner<3, 3>().diagonal().setConstant(rfe.mass);
   for (int a = 0; a < 3; ++a)
     for (int b = a; b < 3; ++b) Mkk(3 + a, 3 + b) = Mkk(3 + b, 3 + a) = p.d.axis[a].dot(IcG.col(b));
-  const int m = static_cast<int>(bk.Xi.size());
+  const int m = static_cast<int>(ancestors.size());
   border.resize(m, 6);
   const Vec4 ph = p.W.col(3);
   for (int j = 0; j < m; ++j) {
-    const Mat4& X = bk.Xi[j];
+    const Mat4& X = Xi[ancestors[j]];
     const Vec3 vj = X.topRows<3>() * ph;                               // velocity of the mass centre
     const Vec3 wj(X(2, 1), X(0, 2), X(1, 0));                           // angular velocity (world)
     border.block<1, 3>(j, 0) = rfe.mass * (p.R0.transpose() * vj).transpose();
@@ -90,15 +90,15 @@ void rfe_mass_blocks(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk,
   G(3, 3) = rfe.mass;
 }
 
-void rfe_gravity_border(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, double g,
-                        MatX& border) {
-  const int m = static_cast<int>(bk.Xi.size());
+void rfe_gravity_border(const Rfe& rfe, const RfePose& p, const std::vector<Mat4>& Xi,
+                        const std::vector<int>& ancestors, double g, MatX& border) {
+  const int m = static_cast<int>(ancestors.size());
   for (int j = 0; j < m; ++j)
     for (int l = 0; l < 3; ++l)
-      border(j, l) += g * rfe.mass * bk.Xi[j].block<1, 3>(2, 0).dot(p.R0.col(l));
+      border(j, l) += g * rfe.mass * Xi[ancestors[j]].block<1, 3>(2, 0).dot(p.R0.col(l));
 }
 
-Mat6 rfe_inertial_stiffness(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk) {
+Mat6 rfe_inertial_stiffness(const Rfe& rfe, const RfePose& p, const LinkFrame& bk) {
   // ε_j = tr(R0 ∂D_j H Ẅᵀ) with Ẅ = B̈0 P; differentiate both factors in q_l.
   const Mat34 F = p.R0.transpose() * p.Wdd;
   const Mat3 B0dd_R = p.R0.transpose() * bk.B0dd.topLeftCorner<3, 3>();
@@ -118,19 +118,19 @@ Mat6 rfe_inertial_stiffness(const Rfe& rfe, const RfePose& p, const BaseKinemati
 
 namespace {
 // Top rows of Ẇ = Ḃ0 P + B0 Ṗ with P = C D.
-Mat34 rfe_velocity(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, const Vec6& v) {
+Mat34 rfe_velocity(const Rfe& rfe, const RfePose& p, const LinkFrame& bk, const Vec6& v) {
   Mat4 P = p.d.D;
   P.topRightCorner<3, 1>() += rfe.centre;
   return (bk.B0d * P).topRows<3>() + lift(bk.B0, d_dot(p.d, v));
 }
 }  // namespace
 
-double rfe_kinetic_energy(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, const Vec6& v) {
+double rfe_kinetic_energy(const Rfe& rfe, const RfePose& p, const LinkFrame& bk, const Vec6& v) {
   const Mat34 Wd = rfe_velocity(rfe, p, bk, v);
   return 0.5 * trace_AHBt(Wd, rfe.H, Wd);
 }
 
-void rfe_momentum_moments(const Rfe& rfe, const RfePose& p, const BaseKinematics& bk, const Vec6& v, Vec3& lin,
+void rfe_momentum_moments(const Rfe& rfe, const RfePose& p, const LinkFrame& bk, const Vec6& v, Vec3& lin,
                           Mat3& A) {
   const Mat34 Wd = rfe_velocity(rfe, p, bk, v);
   const Mat34 WH = p.W.topRows<3>() * rfe.H;

@@ -40,15 +40,20 @@ struct BaseMoments {
 struct Workspace {
   Parallelism parallel;
   BaseKinematics bk;
+  /// A chunk: rfes begin … end − 1 of one link (chunks never span two links).
+  struct Chunk {
+    int link = 0, begin = 0, end = 0;
+  };
+  std::vector<Chunk> chunk;
   std::vector<BaseMoments> moments;  ///< per chunk
   std::vector<double> power;         ///< per chunk: sde dissipation
   std::vector<Vec6> boundary;        ///< per chunk: its first sde's force on the previous chunk's last rfe
   std::vector<Mat6> boundary_block;  ///< per chunk (and target): the same sde's block on that rfe
   VecX zero;                         ///< zeros of the model's size
-  /// Sizes the chunk arrays for n rfes (cleared) and returns the number of chunks.
-  int chunks(int n);
-  int chunk_begin(int c) const { return c * parallel.chunk; }
-  int chunk_end(int c, int n) const { return std::min(n, (c + 1) * parallel.chunk); }
+  std::vector<BaseMoments> node_moments;  ///< per node: its subtree's (suffix sums over the tree)
+  /// Cuts every link of the model into chunks, sizes the chunk arrays (cleared) and returns the
+  /// number of chunks.
+  int chunks(const Model& model);
 };
 
 }  // namespace rfem

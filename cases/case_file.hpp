@@ -1,7 +1,7 @@
 #pragma once
 #include <memory>
-// Case files: human-edited TOML describing materials, sections, the flexible link's segments and
-// discretisation, the base joints and their rigid links, gravity and loads. Every key is checked;
+// Case files: human-edited TOML describing materials, sections, the flexible links' segments and
+// discretisation, the joints and their rigid bodies, what each is mounted on, gravity and loads. Every key is checked;
 // a bad file raises CaseError with a one-line "file:line: key: what is wrong" message.
 // The format is documented in README.md ("Case files").
 #include <stdexcept>
@@ -43,6 +43,15 @@ struct Simulation {
   int flexible_every = 0;            ///< store the full flexible state every k outputs (0: never)
 };
 
+/// A flexible link of a case: [link] (the only one) or an element of [[links]].
+struct LinkCase {
+  std::string name;  ///< [link]: "link"; [[links]]: its name (default link1, link2, …)
+  std::string key;   ///< where its keys are: "link" or "links.i" (messages)
+  FlexibleLink link;
+  int n = 0;         ///< its n if given (0: each segment's parts)
+  Mounting on;       ///< what it sits on (resolved; default: the last joint)
+};
+
 struct Case {
   std::string path;
   std::string text;  ///< the file as read (stored with results)
@@ -50,15 +59,13 @@ struct Case {
   std::vector<std::string> overrides;  ///< the --set key.path=value strings applied
   std::vector<std::string> warnings;   ///< legal but suspicious values ("file:line: key: …")
   std::string name, description;
-  bool has_link = false;
-  FlexibleLink link;
-  int n = 0;                       ///< link.n if given (0: each segment's parts)
-  Mat4 mount = Mat4::Identity();
-  std::vector<Joint> joints;       ///< a free base's six joints first, then [[joints]]
+  std::vector<LinkCase> links;     ///< [link] or [[links]]
+  bool has_link() const { return !links.empty(); }
+  std::vector<Joint> joints;       ///< a free base's six joints first, then [[joints]] (mountings resolved)
   bool free_base = false;          ///< [base] kind = "free"
   VecX joint_values, joint_rates;  ///< initial/held values and steady rates
   double gravity = 0.0;
-  TipLoads loads;
+  TipLoads loads;                  ///< on the link [loads] names (the last by default)
   std::vector<InputSpec> inputs;  ///< one per joint
   Simulation sim;
   bool has_simulation = false;
@@ -68,8 +75,10 @@ struct Case {
 /// (array elements by index: "joints.0.value=0.5", "link.segments.1.parts=4").
 Case read_case(const std::string& path, const std::vector<std::string>& overrides = {});
 
-/// Builds the model with n rfes (n > 0: distributed over the segments by length; n == 0: the
-/// case's own discretisation). Throws CaseError for an impossible discretisation.
+/// Builds the model with n rfes in all (n > 0: distributed over every link's segments by length;
+/// n == 0: each link's own discretisation). Throws CaseError for an impossible discretisation.
 Model build_model(const Case& c, int n = 0);
+/// The number of parts of each link's segments for n rfes in all (as build_model distributes them).
+std::vector<std::vector<int>> link_parts(const Case& c, int n);
 
 }  // namespace rfem

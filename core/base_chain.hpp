@@ -1,5 +1,5 @@
 #pragma once
-// The base: a serial chain of m joints with Craig's modified Denavit–Hartenberg parameters [2.1]
+// Joints: by default a serial chain of m joints (the base) with Craig's modified Denavit–Hartenberg parameters [2.1]
 // A_i(q_i) = RotX(α_{i−1}) TransX(a_{i−1}) RotZ(θ_i) TransZ(d_i), θ_i = q_i + θ_i0 (revolute)
 // or d_i = q_i + d_i0 (prismatic), and the rigid inertia of every base link. A joint may move
 // about (along) another unit axis u of its DH frame instead of z:
@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/joint_drive.hpp"
+#include "core/mounting.hpp"
 #include "core/types.hpp"
 
 namespace rfem {
@@ -22,8 +23,9 @@ struct Joint {
   double theta = 0.0;  ///< θ_i0 [rad]
   double d = 0.0;      ///< d_i0 [m]
   Vec3 axis = Vec3::UnitZ();  ///< unit joint axis in the joint's DH frame (z: Craig's joint)
-  Mat4 H = Mat4::Zero();  ///< pseudo-inertia of base link i in its own frame
+  Mat4 H = Mat4::Zero();  ///< pseudo-inertia of the body it moves (its link, a payload), in its own frame
   JointDrive drive;       ///< rotor/gear inertia, damping, friction of the joint (none by default)
+  Mounting on;            ///< what it sits on (default: the previous joint, a serial chain)
   double mass() const { return H(3, 3); }
 };
 

@@ -2,35 +2,41 @@
 
 namespace rfem {
 
-void base_kinematics(const Model& model, const VecX& qb, const VecX& vb, const VecX& ab,
-                     BaseKinematics& out) {
-  const int m = model.m();
-  out.W.resize(m);
-  out.Xi.resize(m);
-  out.Wd.resize(m);
-  out.Wdd.resize(m);
-  Mat4 W = Mat4::Identity();
-  Mat4 Omega = Mat4::Zero();   // Σ_{j≤i} Ξ_j q̇_j
-  Mat4 Alpha = Mat4::Zero();   // Σ_{j≤i} Ξ_j q̈_j + Σ_{j,l≤i} Ξ_min Ξ_max q̇_j q̇_l
-  for (int i = 0; i < m; ++i) {
-    const Joint& jt = model.joints[i];
-    W = W * joint_transform(jt, qb[i]);
+void base_kinematics(const Model& model, const VecX& q, const VecX& v, const VecX& a, BaseKinematics& out) {
+  const int N = static_cast<int>(model.nodes.size());
+  for (auto* x : {&out.W, &out.Xi, &out.Wd, &out.Wdd, &out.Omega, &out.Alpha}) x->resize(N);
+  for (int i = 0; i < N; ++i) {
+    const Node& nd = model.nodes[i];
+    const int p = nd.parent;
+    const double qi = q[nd.coord], vi = v[nd.coord], ai = a[nd.coord];
+    const Mat4 A = nd.has_pre ? Mat4(nd.pre * joint_transform(nd.motion, qi)) : joint_transform(nd.motion, qi);
+    const Mat4 W = p >= 0 ? Mat4(out.W[p] * A) : Mat4(Mat4::Identity() * A);
+    const Mat4 Omega = p >= 0 ? out.Omega[p] : Mat4::Zero();  // Σ over the ancestors
+    const Mat4 Alpha = p >= 0 ? out.Alpha[p] : Mat4::Zero();
     out.W[i] = W;
-    out.Xi[i] = W * joint_generator(jt) * W.inverse();
-    // Adding joint i: new quadratic terms 2 Ξ_j Ξ_i q̇_j q̇_i (j < i) and Ξ_i² q̇_i².
-    Alpha += out.Xi[i] * ab[i] + (2.0 * Omega + out.Xi[i] * vb[i]) * out.Xi[i] * vb[i];
-    Omega += out.Xi[i] * vb[i];
-    out.Wd[i] = Omega * W;
-    out.Wdd[i] = Alpha * W;
+    out.Xi[i] = W * joint_generator(nd.motion) * W.inverse();
+    // Adding node i to its ancestors' sums: new quadratic terms 2 Ξ_j Ξ_i q̇_j q̇_i and Ξ_i² q̇_i².
+    out.Alpha[i] = Alpha + (out.Xi[i] * ai + (2.0 * Omega + out.Xi[i] * vi) * out.Xi[i] * vi);
+    out.Omega[i] = Omega + out.Xi[i] * vi;
+    out.Wd[i] = out.Omega[i] * W;
+    out.Wdd[i] = out.Alpha[i] * W;
   }
-  const Mat4 Wm = m ? out.W.back() : Mat4::Identity();
-  out.B0 = Wm * model.mount;
-  out.B0d = Omega * out.B0;
-  out.B0dd = Alpha * out.B0;
-  out.Omega_dd = Alpha;
-  out.Omega = Omega;
-  out.w = Vec3(Omega(2, 1), Omega(0, 2), Omega(1, 0));
-  out.wd = 0.5 * Vec3(Alpha(2, 1) - Alpha(1, 2), Alpha(0, 2) - Alpha(2, 0), Alpha(1, 0) - Alpha(0, 1));
+  out.frame.resize(model.links.size());
+  for (size_t l = 0; l < model.links.size(); ++l) {
+    const MountedLink& L = model.links[l];
+    LinkFrame& f = out.frame[l];
+    const int p = L.parent;
+    const Mat4 Wp = p >= 0 ? out.W[p] : Mat4::Identity();
+    f.Omega = p >= 0 ? out.Omega[p] : Mat4::Zero();
+    f.Omega_dd = p >= 0 ? out.Alpha[p] : Mat4::Zero();
+    f.B0 = Wp * L.mount;
+    f.B0d = f.Omega * f.B0;
+    f.B0dd = f.Omega_dd * f.B0;
+    const Mat4& Om = f.Omega;
+    const Mat4& Al = f.Omega_dd;
+    f.w = Vec3(Om(2, 1), Om(0, 2), Om(1, 0));
+    f.wd = 0.5 * Vec3(Al(2, 1) - Al(1, 2), Al(0, 2) - Al(2, 0), Al(1, 0) - Al(0, 1));
+  }
 }
 
 }  // namespace rfem

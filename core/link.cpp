@@ -1,5 +1,6 @@
 #include "core/link.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -93,10 +94,36 @@ std::vector<int> distribute_parts(const FlexibleLink& link, int n) {
   return parts;
 }
 
+int rfe_at(const Discretisation& d, double s) {
+  const int n = d.n();
+  if (n == 0 || s < d.rfes[0].start) return -1;
+  // Spans are contiguous and sorted: the last rfe starting at or before s.
+  const auto it = std::upper_bound(d.rfes.begin(), d.rfes.end(), s, [](double x, const Rfe& r) { return x < r.start; });
+  return static_cast<int>(it - d.rfes.begin()) - 1;
+}
+
+Discretisation Discretisation::rigid() const {
+  Discretisation r;
+  r.length = length;
+  r.damping_beta = damping_beta;
+  r.payloads = payloads;
+  auto moments = [](const Rfe& e) {  // ∫[x;1][x;1]ᵀ dm about {r}'s origin
+    const Mat4 X = homogeneous(Mat3::Identity(), e.centre);
+    return Mat4(X * e.H * X.transpose());
+  };
+  r.rfe0.H = moments(rfe0);
+  for (const Rfe& e : rfes) r.rfe0.H += moments(e);
+  r.rfe0.mass = r.rfe0.H(3, 3);
+  r.rfe0.end = length;
+  r.tip_eta = Vec3(length, 0.0, 0.0);
+  return r;
+}
+
 Discretisation discretise(const FlexibleLink& link) {
   Discretisation d;
   d.length = link.total_length();
   d.damping_beta = link.damping_beta;
+  d.payloads = link.payloads;
   std::vector<double> seg_start;
   double x = 0.0;
   for (const auto& s : link.segments) {

@@ -57,8 +57,15 @@ struct Discretisation {
   Vec3 tip_eta = Vec3::Zero();  ///< free end on the elastic axis, in rfe_n's frame
   double length = 0.0;
   double damping_beta = 0.0;
+  std::vector<Payload> payloads;  ///< (their inertia is in the rfes; kept for their positions)
   int n() const { return static_cast<int>(rfes.size()); }
+  /// Its rigid counterpart (n = 0): no rfes, rfe_0 the whole link's inertia about {r}'s origin.
+  Discretisation rigid() const;
 };
+
+/// The rfe whose span holds the point `s` of the link's axis (spans [start, end), the last one
+/// [start, L]), or −1 for rfe_0's span (rigid with {r}).
+int rfe_at(const Discretisation& d, double s);
 
 /// Discretises the link with each segment's `parts`.
 Discretisation discretise(const FlexibleLink& link);

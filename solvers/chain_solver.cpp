@@ -13,11 +13,25 @@ using CBorderMap = Eigen::Map<const Eigen::Matrix<double, 6, Eigen::Dynamic, Eig
 }  // namespace
 
 ChainSolver::ChainSolver(const BorderedPattern& pattern)
-    : pattern_(pattern), n_(pattern.n_rfes()), nb_(pattern.n_base()), p_(n_ > 0 ? n_ / 2 : -1) {
-  if (n_ > 0) {
-    top_ = {0, p_, 1};                   // blocks 0 … p−1
-    bottom_ = {n_ - 1, n_ - 1 - p_, -1};  // blocks n−1 … p+1
+    : pattern_(pattern), nb_(pattern.n_base()), nc_(static_cast<int>(pattern.chains().size())) {
+  for (int c = 0; c < nc_; ++c) {
+    const BorderedPattern::Chain& ch = pattern.chains()[c];
+    const int half = ch.count / 2, p = ch.first + half, last = ch.first + ch.count - 1;
+    sweeps_.push_back({c, ch.first, half, 1, p});            // blocks first … p−1
+    sweeps_.push_back({c, last, ch.count - 1 - half, -1, p});  // blocks last … p+1
   }
+}
+
+int ChainSolver::iface_index(int c, int i) const {
+  return i < 6 ? 6 * c + i : 6 * nc_ + pattern_.chains()[c].cols[i - 6];
+}
+
+VecX ChainSolver::gather(int c, const VecX& x) const {
+  const std::vector<int>& cols = pattern_.chains()[c].cols;
+  VecX out(6 + cols.size());
+  out.head<6>() = x.segment<6>(6 * c);
+  for (size_t i = 0; i < cols.size(); ++i) out[6 + i] = x[6 * nc_ + cols[i]];
+  return out;
 }
 
 // Block k's coupling to the block before it in the sweep, S(prev, k), stored at E_k (forward) or
@@ -28,7 +42,8 @@ Mat6 ChainSolver::coupling(const double* v, int prev, int k) const {
 }
 
 bool ChainSolver::sweep_factor(double* v, const Sweep& s, MatX& schur) const {
-  schur.setZero(6 + nb_, 6 + nb_);
+  const int w = static_cast<int>(pattern_.chains()[s.chain].cols.size());
+  schur.setZero(6 + w, 6 + w);
   if (s.count == 0) return true;
   // In place: D_k ← L_k (lower Cholesky factor), the coupling slot of k ← F_k = L_prev⁻¹ S(prev, k),
   // B_k ← W_k = L_k⁻¹ (B_k − F_kᵀ W_prev).
@@ -37,30 +52,30 @@ bool ChainSolver::sweep_factor(double* v, const Sweep& s, MatX& schur) const {
     const int k = s.first + i * s.step;
     Block D(v + pattern_.diag(k));
     Mat6 Dk = D.selfadjointView<Eigen::Upper>();
-    BorderMap B(v + pattern_.border(k), 6, nb_);
+    BorderMap B(v + pattern_.border(k), 6, w);
     if (prev >= 0) {
       const Mat6 F = CBlock(v + pattern_.diag(prev)).triangularView<Eigen::Lower>().solve(coupling(v, prev, k));
       Block(v + factor_slot(prev, k)) = F;
       Dk.noalias() -= F.transpose() * F;
-      if (nb_ > 0) B.noalias() -= F.transpose() * CBorderMap(v + pattern_.border(prev), 6, nb_);
+      if (w > 0) B.noalias() -= F.transpose() * CBorderMap(v + pattern_.border(prev), 6, w);
     }
     Eigen::LLT<Mat6> llt(Dk);
     if (llt.info() != Eigen::Success) return false;
     D = llt.matrixL().toDenseMatrix();
-    if (nb_ > 0) {
+    if (w > 0) {
       D.triangularView<Eigen::Lower>().solveInPlace(B);
-      schur.bottomRightCorner(nb_, nb_).noalias() += B.transpose() * B;
+      schur.bottomRightCorner(w, w).noalias() += B.transpose() * B;
     }
     prev = k;
   }
   // The last block's coupling to the separator, eliminated: F_sep = L_last⁻¹ S(last, p).
-  const Mat6 Fs = CBlock(v + pattern_.diag(prev)).triangularView<Eigen::Lower>().solve(coupling(v, p_, prev).transpose());
-  Block(v + factor_slot(prev, p_)) = Fs;
+  const Mat6 Fs = CBlock(v + pattern_.diag(prev)).triangularView<Eigen::Lower>().solve(coupling(v, s.sep, prev).transpose());
+  Block(v + factor_slot(prev, s.sep)) = Fs;
   schur.topLeftCorner<6, 6>().noalias() += Fs.transpose() * Fs;
-  if (nb_ > 0) {
-    const MatX cross = Fs.transpose() * CBorderMap(v + pattern_.border(prev), 6, nb_);
-    schur.topRightCorner(6, nb_) += cross;
-    schur.bottomLeftCorner(nb_, 6) += cross.transpose();
+  if (w > 0) {
+    const MatX cross = Fs.transpose() * CBorderMap(v + pattern_.border(prev), 6, w);
+    schur.topRightCorner(6, w) += cross;
+    schur.bottomLeftCorner(w, 6) += cross.transpose();
   }
   return true;
 }
@@ -68,29 +83,37 @@ bool ChainSolver::sweep_factor(double* v, const Sweep& s, MatX& schur) const {
 bool ChainSolver::factorize(std::vector<double>& values) {
   values_ = nullptr;
   double* v = values.data();
-  const int off = n_ > 0 ? 6 : 0, w = off + nb_;
-  MatX Z(w, w);
-  // The interface: block p and the base, less both sweeps' contributions.
+  const int off = 6 * nc_, size = off + nb_;
+  MatX Z(size, size);
+  // The interface: every chain's separator block and the border, less the sweeps' contributions.
   for (int j = 0; j < nb_; ++j)
-    for (int i = 0; i <= j; ++i)
-      Z(off + i, off + j) = Z(off + j, off + i) = v[pattern_.slot(6 * n_ + i, 6 * n_ + j)];
-  if (n_ > 0) {
-    Z.topLeftCorner<6, 6>() = CBlock(v + pattern_.diag(p_)).selfadjointView<Eigen::Upper>();
-    if (nb_ > 0) {
-      const CBorderMap B(v + pattern_.border(p_), 6, nb_);
-      Z.topRightCorner(6, nb_) = B;
-      Z.bottomLeftCorner(nb_, 6) = B.transpose();
+    for (int i = 0; i <= j; ++i) Z(off + i, off + j) = Z(off + j, off + i) = v[pattern_.base() + static_cast<long>(i) * nb_ + j];
+  if (nc_ > 0) {
+    for (int c = 0; c < nc_; ++c) {
+      const int p = sweeps_[2 * c].sep;
+      const std::vector<int>& cols = pattern_.chains()[c].cols;
+      Z.block<6, 6>(6 * c, 6 * c) = CBlock(v + pattern_.diag(p)).selfadjointView<Eigen::Upper>();
+      for (int d = 0; d < nc_; ++d)
+        if (d != c) Z.block<6, 6>(6 * c, 6 * d).setZero();
+      for (int i = 0; i < nb_; ++i) Z.block<6, 1>(6 * c, off + i).setZero();
+      const CBorderMap B(v + pattern_.border(p), 6, static_cast<long>(cols.size()));
+      for (size_t i = 0; i < cols.size(); ++i) Z.block<6, 1>(6 * c, off + cols[i]) = B.col(static_cast<long>(i));
+      Z.block(off, 6 * c, nb_, 6) = Z.block(6 * c, off, 6, nb_).transpose();
     }
-    bool ok[2] = {true, true};
-    const Sweep* sw[2] = {&top_, &bottom_};
-    MatX schur[2];
-#pragma omp parallel for schedule(static, 1) num_threads(2) if (parallel_)
-    for (int i = 0; i < 2; ++i) ok[i] = sweep_factor(v, *sw[i], schur[i]);
-    if (!ok[0] || !ok[1]) return false;
-    Z -= schur[0];  // fixed order: top, then bottom
-    Z -= schur[1];
+    const int ns = static_cast<int>(sweeps_.size());
+    std::vector<char> ok(ns, 1);
+    std::vector<MatX> schur(ns);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(2) if (parallel_)
+    for (int i = 0; i < ns; ++i) ok[i] = sweep_factor(v, sweeps_[i], schur[i]);
+    for (int i = 0; i < ns; ++i)
+      if (!ok[i]) return false;
+    for (int i = 0; i < ns; ++i) {  // fixed order: chain by chain, top, then bottom
+      const int c = sweeps_[i].chain, w = static_cast<int>(schur[i].rows());
+      for (int b = 0; b < w; ++b)
+        for (int a = 0; a < w; ++a) Z(iface_index(c, a), iface_index(c, b)) -= schur[i](a, b);
+    }
   }
-  if (w > 0) {
+  if (size > 0) {
     iface_.compute(Z);
     if (iface_.info() != Eigen::Success) return false;
   }
@@ -99,7 +122,8 @@ bool ChainSolver::factorize(std::vector<double>& values) {
 }
 
 void ChainSolver::sweep_forward(const Sweep& s, VecX& b, VecX& y_iface) const {
-  y_iface.setZero(6 + nb_);
+  const int w = static_cast<int>(pattern_.chains()[s.chain].cols.size());
+  y_iface.setZero(6 + w);
   if (s.count == 0) return;
   const double* v = values_;
   Vec6 prev_y = Vec6::Zero();
@@ -110,23 +134,24 @@ void ChainSolver::sweep_forward(const Sweep& s, VecX& b, VecX& y_iface) const {
     if (prev >= 0) r.noalias() -= CBlock(v + factor_slot(prev, k)).transpose() * prev_y;
     CBlock(v + pattern_.diag(k)).triangularView<Eigen::Lower>().solveInPlace(r);
     b.segment<6>(6 * k) = r;
-    if (nb_ > 0) y_iface.tail(nb_).noalias() += CBorderMap(v + pattern_.border(k), 6, nb_).transpose() * r;
+    if (w > 0) y_iface.tail(w).noalias() += CBorderMap(v + pattern_.border(k), 6, w).transpose() * r;
     prev_y = r;
     prev = k;
   }
-  y_iface.head<6>().noalias() += CBlock(v + factor_slot(prev, p_)).transpose() * prev_y;
+  y_iface.head<6>().noalias() += CBlock(v + factor_slot(prev, s.sep)).transpose() * prev_y;
 }
 
 void ChainSolver::sweep_backward(const Sweep& s, VecX& b, const VecX& x_iface) const {
   if (s.count == 0) return;
+  const int w = static_cast<int>(x_iface.size()) - 6;
   const double* v = values_;
-  int next = p_;  // the separator's solution is coupled through F_sep
+  int next = s.sep;  // the separator's solution is coupled through F_sep
   Vec6 x_next = x_iface.head<6>();
   for (int i = s.count - 1; i >= 0; --i) {
     const int k = s.first + i * s.step;
     Vec6 r = b.segment<6>(6 * k);
     r.noalias() -= CBlock(v + factor_slot(k, next)) * x_next;
-    if (nb_ > 0) r.noalias() -= CBorderMap(v + pattern_.border(k), 6, nb_) * x_iface.tail(nb_);
+    if (w > 0) r.noalias() -= CBorderMap(v + pattern_.border(k), 6, w) * x_iface.tail(w);
     CBlock(v + pattern_.diag(k)).transpose().triangularView<Eigen::Upper>().solveInPlace(r);
     b.segment<6>(6 * k) = r;
     x_next = r;
@@ -135,26 +160,28 @@ void ChainSolver::sweep_backward(const Sweep& s, VecX& b, const VecX& x_iface) c
 }
 
 void ChainSolver::solve(VecX& b) const {
-  const int off = n_ > 0 ? 6 : 0, w = off + nb_;
-  if (w == 0) return;
-  VecX rhs(w);
-  if (n_ > 0) rhs.head<6>() = b.segment<6>(6 * p_);
+  const int n6 = 6 * pattern_.n_blocks(), off = 6 * nc_, size = off + nb_;
+  if (size == 0) return;
+  VecX rhs(size);
+  for (int c = 0; c < nc_; ++c) rhs.segment<6>(6 * c) = b.segment<6>(6 * sweeps_[2 * c].sep);
   rhs.tail(nb_) = b.tail(nb_);
-  if (n_ == 0) {
+  if (nc_ == 0) {
     b = iface_.solve(rhs);
     return;
   }
-  VecX y[2];
-  const Sweep* sw[2] = {&top_, &bottom_};
-#pragma omp parallel for schedule(static, 1) num_threads(2) if (parallel_)
-  for (int i = 0; i < 2; ++i) sweep_forward(*sw[i], b, y[i]);
-  rhs -= y[0];
-  rhs -= y[1];
+  const int ns = static_cast<int>(sweeps_.size());
+  std::vector<VecX> y(ns);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(2) if (parallel_)
+  for (int i = 0; i < ns; ++i) sweep_forward(sweeps_[i], b, y[i]);
+  for (int i = 0; i < ns; ++i)  // fixed order
+    for (int a = 0; a < y[i].size(); ++a) rhs[iface_index(sweeps_[i].chain, a)] -= y[i][a];
   const VecX x = iface_.solve(rhs);
-  b.segment<6>(6 * p_) = x.head<6>();
-  b.tail(nb_) = x.tail(nb_);
-#pragma omp parallel for schedule(static, 1) num_threads(2) if (parallel_)
-  for (int i = 0; i < 2; ++i) sweep_backward(*sw[i], b, x);
+  for (int c = 0; c < nc_; ++c) b.segment<6>(6 * sweeps_[2 * c].sep) = x.segment<6>(6 * c);
+  b.segment(n6, nb_) = x.tail(nb_);
+  std::vector<VecX> xc(nc_);
+  for (int c = 0; c < nc_; ++c) xc[c] = gather(c, x);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(2) if (parallel_)
+  for (int i = 0; i < ns; ++i) sweep_backward(sweeps_[i], b, xc[sweeps_[i].chain]);
 }
 
 }  // namespace rfem

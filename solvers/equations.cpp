@@ -23,7 +23,7 @@ EquationsOfMotion::EquationsOfMotion(const Model& model, const std::vector<Joint
       terms_(terms),
       governor_(model.n() >= parallel.min_rfes ? (parallel.threads > 0 ? parallel.threads : omp_get_max_threads()) : 1,
                 parallel.threads > 0),
-      damped_(model.link.damping_beta > 0 ||
+      damped_(sdes_damped(model) ||
               std::any_of(model.joints.begin(), model.joints.end(),
                           [](const Joint& j) { return j.drive.damping > 0 || j.drive.friction > 0; })) {
   ws_.parallel = parallel;
@@ -32,14 +32,12 @@ EquationsOfMotion::EquationsOfMotion(const Model& model, const std::vector<Joint
   const int n6 = model.flexible_dofs();
   for (int i = 0; i < n6; ++i) unknown_.push_back(i);
   base_col_.assign(model.m(), -1);
-  int nb = 0;
   for (int j = 0; j < model.m(); ++j)
     if (!inputs[j].prescribed()) {
       base_col_[j] = static_cast<int>(unknown_.size());
       unknown_.push_back(model.joint_index(j));
-      ++nb;
     }
-  newton_ = std::make_unique<NewtonSystem>(model, base_col_, nb, solver, &ws_, keep_stiffness);
+  newton_ = std::make_unique<NewtonSystem>(model, base_col_, solver, &ws_, keep_stiffness);
   std::vector<double> kp, kd;  // feedback laws stiffen and damp their joints (in column order)
   bool feedback = false;
   for (int j = 0; j < model.m(); ++j)
@@ -108,7 +106,7 @@ Power EquationsOfMotion::power_change(double t, const double* vu, const VecX& da
       d.input += law.at(t, q_[model_.joint_index(j)], vj) * dv - (law.stiffness() * dq + law.damping() * dv) * vj;
     }
   }
-  if (model_.link.damping_beta > 0) {  // the Newton system keeps the sdes' C only then
+  if (sdes_damped(model_)) {  // the Newton system keeps the sdes' C only then
     VecX Cda;
     newton_->damping_times(da, Cda);
     d.dissipation = 2.0 * hg * Eigen::Map<const VecX>(vu, unknowns()).dot(Cda);

@@ -7,25 +7,31 @@ bool solve_mass(const Model& model, const BorderedPattern& pattern, const std::v
   MatrixTerms mt;
   mt.mass = 1.0;
   assemble_matrices(model, pattern, base_col, q, v, mt, values, {});
-  const int n = pattern.n_rfes(), nb = pattern.n_base(), n6 = 6 * n;
+  const int n = pattern.n_blocks(), nb = pattern.n_base(), n6 = 6 * n;
   auto entry = [&](int r, int c) { return values[pattern.slot(std::min(r, c), std::max(r, c))]; };
-  MatX S(nb, nb);  // Schur complement on the free joints
+  MatX S(nb, nb);  // Schur complement on the border
   for (int i = 0; i < nb; ++i)
     for (int j = 0; j < nb; ++j) S(i, j) = entry(n6 + i, n6 + j);
   VecX rb = b.tail(nb);
   std::vector<Eigen::LLT<Mat6>> llt(n);
   for (int k = 0; k < n; ++k) {
+    const std::vector<int>& cols = pattern.chains()[pattern.chain_of(k)].cols;
+    const int w = static_cast<int>(cols.size());
     Mat6 Mkk;
-    Eigen::Matrix<double, 6, Eigen::Dynamic> B(6, nb);
+    Eigen::Matrix<double, 6, Eigen::Dynamic> B(6, w);
     for (int i = 0; i < 6; ++i) {
       for (int j = 0; j < 6; ++j) Mkk(i, j) = entry(6 * k + i, 6 * k + j);
-      for (int j = 0; j < nb; ++j) B(i, j) = entry(6 * k + i, n6 + j);
+      for (int j = 0; j < w; ++j) B(i, j) = entry(6 * k + i, n6 + cols[j]);
     }
     llt[k].compute(Mkk);
     if (llt[k].info() != Eigen::Success) return false;
-    if (nb > 0) {
-      S.noalias() -= B.transpose() * llt[k].solve(B);
-      rb.noalias() -= B.transpose() * llt[k].solve(b.segment<6>(6 * k));
+    if (w > 0) {
+      const MatX s = B.transpose() * llt[k].solve(B);
+      const VecX r = B.transpose() * llt[k].solve(b.segment<6>(6 * k));
+      for (int i = 0; i < w; ++i) {
+        rb[cols[i]] -= r[i];
+        for (int j = 0; j < w; ++j) S(cols[i], cols[j]) -= s(i, j);
+      }
     }
   }
   if (nb > 0) {
@@ -34,9 +40,10 @@ bool solve_mass(const Model& model, const BorderedPattern& pattern, const std::v
     b.tail(nb) = sl.solve(rb);
   }
   for (int k = 0; k < n; ++k) {
+    const std::vector<int>& cols = pattern.chains()[pattern.chain_of(k)].cols;
     Vec6 rhs = b.segment<6>(6 * k);
-    for (int j = 0; j < nb; ++j)
-      for (int i = 0; i < 6; ++i) rhs[i] -= entry(6 * k + i, n6 + j) * b[n6 + j];
+    for (int col : cols)
+      for (int i = 0; i < 6; ++i) rhs[i] -= entry(6 * k + i, n6 + col) * b[n6 + col];
     b.segment<6>(6 * k) = llt[k].solve(rhs);
   }
   return true;

@@ -33,21 +33,25 @@ struct BlockMass {
   std::vector<Mat6> M, L;
 };
 
+// Every rfe's own 6×6 mass block, in the order of the coordinates (block i: coordinates 6i … 6i+5).
 BlockMass block_mass(const Model& model, const VecX& q) {
   BlockMass bm;
-  const int n = model.n();
-  bm.M.resize(n);
-  bm.L.resize(n);
+  bm.M.resize(model.n());
+  bm.L.resize(model.n());
   BaseKinematics bk;
-  const VecX z = VecX::Zero(model.m());
-  base_kinematics(model, model.joint_coords(q), z, z, bk);
-  for (int k = 0; k < n; ++k) {
-    RfePose pose;
-    rfe_pose(model.link.rfes[k], bk, q.segment<6>(model.rfe_index(k)), Vec6::Zero(), Vec6::Zero(), pose, false);
-    MatX border;
-    Mat4 G;
-    rfe_mass_blocks(model.link.rfes[k], pose, bk, bm.M[k], border, G);
-    bm.L[k] = bm.M[k].llt().matrixL();
+  const VecX z = VecX::Zero(model.dof());
+  base_kinematics(model, q, z, z, bk);
+  for (size_t l = 0; l < model.links.size(); ++l) {
+    const MountedLink& L = model.links[l];
+    for (int k = 0; k < L.n(); ++k) {
+      const int at = model.rfe_index(static_cast<int>(l), k), i = at / Model::rfe_dofs;
+      RfePose pose;
+      rfe_pose(L.d.rfes[k], bk.frame[l], q.segment<6>(at), Vec6::Zero(), Vec6::Zero(), pose, false);
+      MatX border;
+      Mat4 G;
+      rfe_mass_blocks(L.d.rfes[k], pose, bk.Xi, {}, bm.M[i], border, G);
+      bm.L[i] = bm.M[i].llt().matrixL();
+    }
   }
   return bm;
 }
@@ -62,14 +66,14 @@ class ShiftInvertOp {
   Eigen::Index cols() const { return pattern_.size(); }
   void set_shift(double sigma) {
     std::vector<double> S = K_;
-    for (int k = 0; k < pattern_.n_rfes(); ++k)
+    for (int k = 0; k < pattern_.n_blocks(); ++k)
       for (int l = 0; l < 6; ++l)
         for (int j = 0; j <= l; ++j) S[pattern_.slot(6 * k + j, 6 * k + l)] -= sigma * bm_.M[k](j, l);
     if (!solver_.factorize(S))
       throw std::runtime_error("modal analysis: K − σM is not positive definite (is the link buckled?)");
   }
   void perform_op(const double* x, double* y) const {
-    const int n = pattern_.n_rfes();
+    const int n = pattern_.n_blocks();
     VecX b(6 * n);
     for (int k = 0; k < n; ++k) b.segment<6>(6 * k) = bm_.L[k] * Eigen::Map<const Vec6>(x + 6 * k);
     solver_.solve(b);
@@ -83,7 +87,7 @@ class ShiftInvertOp {
   CholmodSolver solver_;
 };
 
-// With free joints M is bordered, not block diagonal: the generalised problem K φ = λ M φ in
+// With free joints or carrying rfes M is bordered, not block diagonal: the generalised problem K φ = λ M φ in
 // Spectra's shift-invert mode, (K − σM)⁻¹ by CHOLMOD and M x on the pattern.
 class GeneralShiftInvertOp {
  public:
@@ -156,6 +160,8 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
                           const std::vector<int>& free) {
   const int n = model.n(), nf = static_cast<int>(free.size()), N = model.flexible_dofs() + nf;
   if (n == 0) throw std::invalid_argument("modal analysis needs a flexible link (n ≥ 1)");
+  for (const MountedLink& L : model.links)
+    if (L.n() == 0) throw std::invalid_argument("modal analysis needs every link flexible (link " + L.name + " has n = 0)");
   if (std::set<int>(free.begin(), free.end()).size() != free.size())
     throw std::invalid_argument("a joint is freed twice");
   for (int j : free)
@@ -180,7 +186,8 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
                                     std::to_string(tau[j]) + (model.joints[j].type == JointType::Revolute ? " N m" : " N") + " in the held equilibrium: freed, it has no "
                                     "equilibrium to linearise about");
   }
-  const BorderedPattern pattern(n, nf);
+  const BorderedPattern pattern(model, cols);
+  const bool bordered = pattern.n_base() > 0;  // M is then not block diagonal
   MatrixTerms terms;
   terms.stiffness = 1.0;
   terms.gravity = true;
@@ -188,7 +195,7 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
   std::vector<double> K, Mv;
   assemble_matrix(model, pattern, cols, res.q0, v, terms, K);
   const BlockMass bm = block_mass(model, res.q0);
-  if (nf > 0) {
+  if (bordered) {
     MatrixTerms mt;
     mt.mass = 1.0;
     assemble_matrix(model, pattern, cols, res.q0, v, mt, Mv);
@@ -196,9 +203,9 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
   VecX lambda;
   if (N <= dense_limit) {
     MatX Md = MatX::Zero(N, N);
-    if (nf > 0) Md = to_dense(pattern, Mv);
+    if (bordered) Md = to_dense(pattern, Mv);
     else
-      for (int k = 0; k < n; ++k) Md.block<6, 6>(model.rfe_index(k), model.rfe_index(k)) = bm.M[k];
+      for (int k = 0; k < n; ++k) Md.block<6, 6>(6 * k, 6 * k) = bm.M[k];
     Eigen::GeneralizedSelfAdjointEigenSolver<MatX> es(to_dense(pattern, K), Md);
     if (es.info() != Eigen::Success) throw std::runtime_error("modal analysis: dense eigen-solver failed");
     lambda = es.eigenvalues().head(count);
@@ -213,9 +220,10 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
     // σ₁ = 0. Free joints: M is bordered, the generalised problem, and σ₁ just below 0, where the
     // rigid-body modes make K singular.
     const int ncv = std::min(N, std::max(2 * count + 1, count + 20));
-    const double scale = 1e-3 * std::abs(K[pattern.diag(n - 1)] / bm.M[n - 1](0, 0));
+    const int last = pattern.n_blocks() > 0 ? pattern.n_blocks() - 1 : n - 1;  // an rfe of a chain, if any
+    const double scale = 1e-3 * std::abs(K[pattern.slot(6 * last, 6 * last)] / bm.M[last](0, 0));
     auto lanczos = [&](double sigma, VecX& lam, MatX& shapes) {
-      if (nf > 0) {
+      if (bordered) {
         GeneralShiftInvertOp op(pattern, K, Mv);
         MassProductOp bop(pattern, Mv);
         Spectra::SymGEigsShiftSolver<GeneralShiftInvertOp, MassProductOp, Spectra::GEigsMode::ShiftInvert> eigs(
@@ -230,8 +238,7 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
       shapes.resize(N, count);
       for (int i = 0; i < count; ++i)
         for (int k = 0; k < n; ++k)  // φ = L⁻ᵀ u
-          shapes.col(i).segment<6>(model.rfe_index(k)) =
-              bm.L[k].transpose().triangularView<Eigen::Upper>().solve(U.col(i).segment<6>(model.rfe_index(k)));
+          shapes.col(i).segment<6>(6 * k) = bm.L[k].transpose().triangularView<Eigen::Upper>().solve(U.col(i).segment<6>(6 * k));
     };
     const double sigma = nf > 0 ? -1e-6 * scale : 0.0;
     lanczos(sigma, lambda, res.shapes);
@@ -248,8 +255,7 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
   // Rigid-body modes: ω² at the round-off of a zero eigenvalue of the stiffest coordinate.
   double stiffest = 0.0;
   for (int k = 0; k < n; ++k)
-    for (int i = 0; i < 6; ++i)
-      stiffest = std::max(stiffest, K[pattern.slot(model.rfe_index(k) + i, model.rfe_index(k) + i)] / bm.M[k](i, i));
+    for (int i = 0; i < 6; ++i) stiffest = std::max(stiffest, K[pattern.slot(6 * k + i, 6 * k + i)] / bm.M[k](i, i));
   res.omega = lambda.cwiseMax(0.0).cwiseSqrt();
   for (int i = 0; i < count; ++i) {
     const bool rigid = nf > 0 && std::abs(lambda[i]) <= kRigidModeFraction * stiffest;

@@ -4,14 +4,14 @@
 
 namespace rfem {
 
-NewtonSystem::NewtonSystem(const Model& model, std::vector<int> base_col, int nb, LinearSolverKind kind,
-                           Workspace* ws, bool keep_stiffness)
+NewtonSystem::NewtonSystem(const Model& model, std::vector<int> base_col, LinearSolverKind kind, Workspace* ws,
+                           bool keep_stiffness)
     : model_(model),
       ws_(ws ? *ws : own_),
       base_col_(std::move(base_col)),
-      pattern_(model.n(), nb),
+      pattern_(model, base_col_),
       solver_(make_linear_solver(kind, pattern_)),
-      damped_(model.link.damping_beta != 0.0),
+      damped_(sdes_damped(model)),
       keep_stiffness_(keep_stiffness) {}
 
 bool NewtonSystem::setup(const VecX& q, const VecX& v, double h) {
@@ -23,9 +23,9 @@ bool NewtonSystem::setup(const VecX& q, const VecX& v, double h) {
   if (keep_stiffness_) extra.push_back({&K_, 1.0, 0.0});
   if (damped_) extra.push_back({&C_, 0.0, 1.0});
   assemble_matrices(model_, pattern_, base_col_, q, v, terms, S_, extra, &base_rows_, &ws_);
-  const int nb = pattern_.n_base();
+  const int nb = pattern_.n_base(), first = nb - static_cast<int>(kp_.size());  // unknown joints end the border
   for (int c = 0; c < static_cast<int>(kp_.size()); ++c) {
-    const long d = pattern_.base() + static_cast<long>(c) * nb + c;
+    const long d = pattern_.base() + static_cast<long>(first + c) * nb + first + c;
     S_[d] += h * kd_[c] + h * h * kp_[c];
     if (keep_stiffness_) K_[d] += kp_[c];
   }
@@ -35,7 +35,9 @@ bool NewtonSystem::setup(const VecX& q, const VecX& v, double h) {
 }
 
 void NewtonSystem::set_joint_feedback(std::vector<double> kp, std::vector<double> kd) {
-  if (static_cast<int>(kp.size()) != pattern_.n_base() || kd.size() != kp.size())
+  int unknown_joints = 0;
+  for (int c : base_col_) unknown_joints += c >= 0;
+  if (static_cast<int>(kp.size()) != unknown_joints || kd.size() != kp.size())
     throw std::invalid_argument("one feedback gain pair per unknown joint is required");
   kp_ = std::move(kp);
   kd_ = std::move(kd);

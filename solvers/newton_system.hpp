@@ -16,9 +16,9 @@ namespace rfem {
 class NewtonSystem {
  public:
   /// base_col[j]: joint j's column among the unknowns (numbered after the 6n rfe coordinates), −1
-  /// if prescribed; nb = number of unknown joints. `ws`: the caller's workspace (thread policy and
-  /// scratch of the assembly), or null for one of its own. `keep_stiffness`: keep K (IDA's solve).
-  NewtonSystem(const Model& model, std::vector<int> base_col, int nb, LinearSolverKind kind = LinearSolverKind::Chain,
+  /// if prescribed. `ws`: the caller's workspace (thread policy and scratch of the assembly), or
+  /// null for one of its own. `keep_stiffness`: keep K (IDA's solve).
+  NewtonSystem(const Model& model, std::vector<int> base_col, LinearSolverKind kind = LinearSolverKind::Chain,
                Workspace* ws = nullptr, bool keep_stiffness = false);
   /// Stiffness and damping a feedback law adds on the unknown joints' diagonal (one per unknown
   /// joint, in column order): S gains h kd + h² kp, IDA's K gains kp.

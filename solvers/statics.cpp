@@ -11,7 +11,7 @@
 
 namespace rfem {
 
-Vec6 tip_generalised_force(const Model& model, const Vec6& qn, const TipLoads& loads) {
+Vec6 tip_generalised_force(const Model& model, int l, const Vec6& qn, const TipLoads& loads) {
   DeformationTransform d;
   deformation_transform(qn, d);
   Vec6 Q;
@@ -20,43 +20,97 @@ Vec6 tip_generalised_force(const Model& model, const Vec6& qn, const TipLoads& l
   const Mat3 Ry = rot_y(qn[4]), Ryz = Ry * rot_z(qn[5]);
   const Vec3 axes[3] = {Ryz.col(0), Vec3::UnitY(), Ry.col(2)};
   for (int a = 0; a < 3; ++a)
-    Q[3 + a] = loads.force.dot(d.dR[a] * model.link.tip_eta) + loads.moment.dot(axes[a]);
+    Q[3 + a] = loads.force.dot(d.dR[a] * model.links[l].d.tip_eta) + loads.moment.dot(axes[a]);
   return Q;
 }
 
-Vec6 tip_motion(const Model& model, const VecX& q) {
-  const int n = model.n();
+Vec6 tip_motion(const Model& model, int l, const VecX& q) {
+  const MountedLink& L = model.links[l];
   Vec6 out = Vec6::Zero();
-  if (n == 0) return out;
-  const Vec6 qn = q.segment<6>(model.rfe_index(n - 1));
+  if (L.n() == 0) return out;
+  const Vec6 qn = q.segment<6>(model.rfe_index(l, L.n() - 1));
   DeformationTransform d;
   deformation_transform(qn, d);
-  const Vec3& eta = model.link.tip_eta;
+  const Vec3& eta = L.d.tip_eta;
   out.head<3>() = qn.head<3>() + d.D.topLeftCorner<3, 3>() * eta - eta;
   out.tail<3>() = qn.tail<3>();
   return out;
 }
 
-Vec3 tip_position(const Model& model, const VecX& q) {
-  const int m = model.m(), n = model.n();
+Vec3 point_position(const Model& model, int l, double s, const VecX& q) {
+  const MountedLink& L = model.links[l];
   BaseKinematics bk;
-  const VecX z = VecX::Zero(m);
-  base_kinematics(model, model.joint_coords(q), z, z, bk);
-  Vec3 local = Vec3(model.link.length, 0.0, 0.0);  // the rigid manipulator: the link's end, rigid with {r}
-  if (n > 0) {
-    const Vec6 qn = q.segment<6>(model.rfe_index(n - 1));
+  const VecX z = VecX::Zero(model.dof());
+  base_kinematics(model, q, z, z, bk);
+  Vec3 local(s, 0.0, 0.0);  // rigid with {r}
+  if (const int k = rfe_at(L.d, s); k >= 0) {
+    const Vec6 qk = q.segment<6>(model.rfe_index(l, k));
+    DeformationTransform d;
+    deformation_transform(qk, d, false);
+    const Vec3 eta = Vec3(s, 0.0, 0.0) - L.d.rfes[k].centre;  // in the rfe's frame
+    local = L.d.rfes[k].centre + qk.head<3>() + d.D.topLeftCorner<3, 3>() * eta;
+  }
+  const Mat4& B0 = bk.frame[l].B0;
+  return B0.topLeftCorner<3, 3>() * local + B0.topRightCorner<3, 1>();
+}
+
+Vec3 tip_position(const Model& model, int l, const VecX& q) { return point_position(model, l, model.links[l].d.length, q); }
+
+std::vector<Vec3> joint_positions(const Model& model, const VecX& q) {
+  BaseKinematics bk;
+  const VecX z = VecX::Zero(model.dof());
+  base_kinematics(model, q, z, z, bk);
+  std::vector<Vec3> out;
+  for (int i : model.joint_node) out.push_back(bk.W[i].topRightCorner<3, 1>());
+  return out;
+}
+
+int loaded_link(const Model& model, const TipLoads& loads) {
+  const int nl = static_cast<int>(model.links.size());
+  const int l = loads.link < 0 ? nl - 1 : loads.link;
+  if (l < 0 || l >= nl) throw std::invalid_argument("tip loads on link " + std::to_string(l + 1) + ", which does not exist");
+  return l;
+}
+
+VecX tip_load_forces(const Model& model, const VecX& q, const TipLoads& loads) {
+  const int l = loaded_link(model, loads);
+  const MountedLink& L = model.links[l];
+  VecX Q = VecX::Zero(model.dof());
+  BaseKinematics bk, ref;
+  const VecX z = VecX::Zero(model.dof());
+  base_kinematics(model, q, z, z, bk);
+  VecX q0 = q;  // the undeformed state: the loads' directions
+  q0.head(model.flexible_dofs()).setZero();
+  base_kinematics(model, q0, z, z, ref);
+  const Mat3 R0 = bk.frame[l].B0.topLeftCorner<3, 3>(), Rref = ref.frame[l].B0.topLeftCorner<3, 3>();
+  const Vec3 F = Rref * loads.force, M = Rref * loads.moment;  // in {0}
+  Vec3 local(L.d.length, 0.0, 0.0);  // the tip in {r}
+  if (L.n() > 0) {
+    const int at = model.rfe_index(l, L.n() - 1);
+    const Vec6 qn = q.segment<6>(at);
+    TipLoads own = loads;  // in the axes of {r} now (the same when {r} has not moved)
+    if (R0 != Rref) {
+      own.force = R0.transpose() * F;
+      own.moment = R0.transpose() * M;
+    }
+    Q.segment<6>(at) = tip_generalised_force(model, l, qn, own);
     DeformationTransform d;
     deformation_transform(qn, d, false);
-    local = model.link.rfes.back().centre + qn.head<3>() + d.D.topLeftCorner<3, 3>() * model.link.tip_eta;
+    local = L.d.rfes.back().centre + qn.head<3>() + d.D.topLeftCorner<3, 3>() * L.d.tip_eta;
   }
-  return bk.B0.topLeftCorner<3, 3>() * local + bk.B0.topRightCorner<3, 1>();
+  const Mat4& B0 = bk.frame[l].B0;
+  const Vec4 p = B0 * Vec4(local[0], local[1], local[2], 1.0);
+  for (int j : L.ancestors) {  // ∂p/∂q_j = (Ξ_j p)₁₋₃, ω_j = vee of Ξ_j's rotation
+    const Mat4& X = bk.Xi[j];
+    Q[model.nodes[j].coord] += F.dot((X * p).head<3>()) + M.dot(Vec3(X(2, 1), X(0, 2), X(1, 0)));
+  }
+  return Q;
 }
 
 namespace {
 
 // Residual of the flexible rows at load factor lam: internal + gravity + centrifugal − tip loads.
 VecX residual(const Model& model, const VecX& q, const VecX& v, const TipLoads& loads, double lam) {
-  const int n = model.n();
   VecX F;
   const VecX a = VecX::Zero(model.dof());
   ForceTerms terms;
@@ -67,7 +121,7 @@ VecX residual(const Model& model, const VecX& q, const VecX& v, const TipLoads& 
   VecX L;
   generalised_forces(model, q, v, a, load_terms, L);
   VecX r = F.head(model.flexible_dofs()) - (1.0 - lam) * L.head(model.flexible_dofs());
-  r.segment<6>(model.rfe_index(n - 1)) -= lam * tip_generalised_force(model, q.segment<6>(model.rfe_index(n - 1)), loads);
+  r -= lam * tip_load_forces(model, q, loads).head(model.flexible_dofs());
   return r;
 }
 
@@ -76,14 +130,17 @@ VecX residual(const Model& model, const VecX& q, const VecX& v, const TipLoads& 
 StaticResult solve_static(const Model& model, const VecX& qb, const VecX& vb, const TipLoads& loads,
                           const StaticOptions& opts) {
   const int n = model.n(), m = model.m();
+  if (qb.size() != m || (vb.size() != 0 && vb.size() != m))
+    throw std::invalid_argument("solve_static: " + std::to_string(m) + " joint values and rates (or none) are required, got " +
+                                std::to_string(qb.size()) + " and " + std::to_string(vb.size()));
   StaticResult res;
   res.q = VecX::Zero(model.dof());
   model.joint_coords(res.q) = qb;
   if (n == 0) return res;
   VecX v = VecX::Zero(model.dof());
-  model.joint_coords(v) = vb;
-  const BorderedPattern pattern(n, 0);
+  if (vb.size()) model.joint_coords(v) = vb;
   const std::vector<int> held(m, -1);
+  const BorderedPattern pattern(model, held);
   CholmodSolver solver(pattern);
   MatrixTerms terms;
   terms.stiffness = 1.0;

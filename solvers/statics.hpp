@@ -1,5 +1,5 @@
 #pragma once
-// Static equilibrium of the flexible link with the joints held at given values (and, for a
+// Static equilibrium of the flexible links with the joints held at given values (and, for a
 // steadily rotating base, given joint rates): f_el(q) + f_g(q) + h(q, v_b) = Q_tip(q), solved by
 // Newton iteration with the CHOLMOD factor of the stiffness (elastic with geometric term, gravity,
 // centrifugal), with load stepping when a full step does not converge.
@@ -7,11 +7,12 @@
 
 namespace rfem {
 
-/// Loads at the free end of the flexible link, on the elastic axis, in {r} axes (dead loads in
-/// the base frame).
+/// Loads at the free end of a flexible link, on the elastic axis, in its {r} axes (dead loads in
+/// the frame the link is mounted in).
 struct TipLoads {
   Vec3 force = Vec3::Zero();   ///< [N]
   Vec3 moment = Vec3::Zero();  ///< [N m]
+  int link = -1;               ///< the link (−1: the last one)
 };
 
 struct StaticOptions {
@@ -32,12 +33,25 @@ struct StaticResult {
 StaticResult solve_static(const Model& model, const VecX& qb, const VecX& vb, const TipLoads& loads,
                           const StaticOptions& opts = {});
 
-/// Generalised force of the tip loads on rfe_n's coordinates.
-Vec6 tip_generalised_force(const Model& model, const Vec6& qn, const TipLoads& loads);
+/// Generalised force of tip loads on the coordinates qn of link l's last rfe, the loads in {r} axes.
+Vec6 tip_generalised_force(const Model& model, int l, const Vec6& qn, const TipLoads& loads);
+/// Generalised forces (all coordinates) of dead tip loads on link loads.link: force and moment are
+/// given in the axes of the link's {r} at the undeformed state (every rfe coordinate zero) and keep
+/// that direction in {0}; Q_j = F·∂p/∂q_j + M·ω_j over every coordinate that moves the tip — the
+/// link's last rfe and every node that carries the link (a link on another's tip loads both).
+VecX tip_load_forces(const Model& model, const VecX& q, const TipLoads& loads);
 
-/// Tip displacement (3, in {r}) and small rotation (3) of the free end relative to undeformed.
-Vec6 tip_motion(const Model& model, const VecX& q);
-/// Position of the free end (on the elastic axis) in the inertial frame {0} (full coordinates q).
-Vec3 tip_position(const Model& model, const VecX& q);
+/// Link l's free end: displacement (3, in its {r}) and small rotation (3) relative to undeformed.
+Vec6 tip_motion(const Model& model, int l, const VecX& q);
+/// Position in {0} of the point at s along link l's elastic axis, moving with the rfe whose span
+/// holds it (rfe_0's span, or a rigid link: with {r}); full coordinates q.
+Vec3 point_position(const Model& model, int l, double s, const VecX& q);
+/// Position of link l's free end (on the elastic axis) in the inertial frame {0}.
+Vec3 tip_position(const Model& model, int l, const VecX& q);
+/// Origin of every joint's frame (where the body it moves is placed) in {0}.
+std::vector<Vec3> joint_positions(const Model& model, const VecX& q);
+/// The link tip loads act on (TipLoads::link, −1 for the last); throws std::invalid_argument if
+/// there is none.
+int loaded_link(const Model& model, const TipLoads& loads);
 
 }  // namespace rfem

@@ -8,6 +8,7 @@
 #include "assembly/assemble.hpp"
 #include "assembly/dense_reference.hpp"
 #include "solvers/cholmod_solver.hpp"
+#include "solvers/mass_solve.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;
@@ -102,4 +103,83 @@ TEST(Assembly, PatternHasNoFill) {
   EXPECT_EQ(b.entries() - a.entries(), 100 * (21 + 36 + 18));
   EXPECT_EQ(b.nnz() - a.nnz(), 100 * (72 + 18));
   EXPECT_EQ(static_cast<long>(b.csc().rowind.size()), b.entries());
+}
+
+namespace {
+// The rows and columns of a dense full-coordinate matrix that are unknowns: every rfe coordinate,
+// then the joints with base_col ≥ 0 (EquationsOfMotion's numbering).
+MatX unknown_part(const Model& m, const std::vector<int>& base_col, const MatX& A) {
+  std::vector<int> idx;
+  for (int i = 0; i < m.flexible_dofs(); ++i) idx.push_back(i);
+  for (int j = 0; j < m.m(); ++j)
+    if (base_col[j] >= 0) idx.push_back(m.joint_index(j));
+  MatX out(idx.size(), idx.size());
+  for (size_t r = 0; r < idx.size(); ++r)
+    for (size_t c = 0; c < idx.size(); ++c) out(r, c) = A(idx[r], idx[c]);
+  return out;
+}
+}  // namespace
+
+TEST(Assembly, TreeSparseEqualsDenseReferenceWithOneAndTwoThreads) {
+  // Links on links, joints on rfes, a branch and a slider (test::tree_arm), with every joint
+  // unknown and with two of them prescribed (their rows and columns leave the pattern).
+  Model m = test::tree_arm(3, 0.002);
+  m.joints[1].drive = {0.3, 0.5, 0.2, 0.4};
+  VecX q, v, a;
+  test::random_state(m, 31, q, v, a);
+  const MatX ref = 400.0 * dense_mass_matrix(m, q) + 20.0 * dense_damping(m, q, v) + dense_stiffness(m, q, true);
+  for (const std::vector<int>& unknown : {std::vector<int>{0, 1, 2, 3}, std::vector<int>{1, 3}}) {
+    std::vector<int> cols(m.m(), -1);
+    for (size_t i = 0; i < unknown.size(); ++i) cols[unknown[i]] = m.flexible_dofs() + static_cast<int>(i);
+    const BorderedPattern p(m, cols);
+    const MatX expect = unknown_part(m, cols, ref);
+    std::vector<double> vals[2];
+    for (int threads : {1, 2}) {
+      Workspace ws = workspace(threads);
+      MatrixTerms t;
+      t.mass = 400.0;
+      t.damping = 20.0;
+      t.stiffness = 1.0;
+      t.gravity = true;
+      assemble_matrix(m, p, cols, q, v, t, vals[threads - 1], &ws);
+      EXPECT_LT((to_dense(p, vals[threads - 1]) - expect).norm() / expect.norm(), 1e-12) << threads << " thread(s)";
+    }
+    EXPECT_EQ(vals[0], vals[1]) << "assembly must not depend on the thread count";
+  }
+}
+
+TEST(Assembly, TreeForcesIndependentOfThreadCountAndChunks) {
+  const Model m = test::tree_arm(40, 0.001);
+  VecX q, v, a;
+  test::random_state(m, 32, q, v, a);
+  q.head(m.flexible_dofs()) *= 0.1;
+  VecX f[2], g;
+  Energies e[2];
+  for (int t : {1, 2}) {
+    Workspace ws = workspace(t, 7);
+    generalised_forces(m, q, v, a, ForceTerms{}, f[t - 1], nullptr, &ws);
+    e[t - 1] = energies(m, q, v, &ws);
+  }
+  EXPECT_EQ((f[0] - f[1]).lpNorm<Eigen::Infinity>(), 0.0);
+  EXPECT_EQ(e[0].kinetic, e[1].kinetic);
+  EXPECT_EQ(e[0].elastic, e[1].elastic);
+  Workspace serial = workspace(1, 100000);
+  generalised_forces(m, q, v, a, ForceTerms{}, g, nullptr, &serial);
+  EXPECT_LT((f[0] - g).norm(), 1e-12 * g.norm());
+}
+
+TEST(Assembly, TreeMassSolveEqualsDenseSolve) {
+  // Accelerations by block elimination (solvers/mass_solve.hpp) on the tree's bordered pattern.
+  const Model m = test::tree_arm(3);
+  VecX q, v, a;
+  test::random_state(m, 33, q, v, a);
+  std::vector<int> cols(m.m(), -1);
+  cols[1] = m.flexible_dofs();
+  const BorderedPattern p(m, cols);
+  const MatX M = unknown_part(m, cols, dense_mass_matrix(m, q));
+  VecX b = VecX::LinSpaced(p.size(), -1.0, 1.0), x = b;
+  std::vector<double> scratch;
+  ASSERT_TRUE(solve_mass(m, p, cols, q, v, x, scratch));
+  const VecX ref = M.ldlt().solve(b);
+  EXPECT_LT((x - ref).norm(), 1e-10 * ref.norm());
 }

@@ -42,7 +42,7 @@ double timoshenko_bound(const Segment& s, double beta_l, double I) {
 
 TEST(Cantilever, BendingFrequenciesConvergeWithOrderTwoInBothPlanes) {
   const Case c = kane();
-  const Segment& seg = c.link.segments[0];
+  const Segment& seg = c.links[0].link.segments[0];
   for (const auto& [kind, name, I] : {std::tuple{ModeKind::BendingY, "bending-y", seg.section.Iz},
                                       std::tuple{ModeKind::BendingZ, "bending-z", seg.section.Iy}}) {
     for (int k = 1; k <= 3; ++k) {
@@ -67,9 +67,9 @@ TEST(Cantilever, TipPayloadMatchesTheTipMassFrequencyEquation) {
   // the same Timoshenko bound as the free cantilever's (the payload adds no shear of its own).
   // Without the payload, or with it on the wrong rfe, mode 1 would be 40 % higher.
   const Case c = read_case(test::source_path("cases/kane_tip_mass.toml"), {"sections.kane.Iz=3e-7"});
-  const Segment& seg = c.link.segments[0];
+  const Segment& seg = c.links[0].link.segments[0];
   const double rhoA = seg.material.rho * seg.section.A, L = seg.length, mu = 6.0 / (rhoA * L), eta = 1.2 / (rhoA * L * L * L);
-  ASSERT_EQ(c.link.payloads.size(), 1u);
+  ASSERT_EQ(c.links[0].link.payloads.size(), 1u);
   for (const auto& [name, I] : {std::pair{"bending-y", seg.section.Iz}, std::pair{"bending-z", seg.section.Iy}}) {
     for (int k = 1; k <= 2; ++k) {
       const Series s = series(c, std::string(name) + ":" + std::to_string(k));
@@ -92,7 +92,7 @@ TEST(Cantilever, TipPayloadMatchesTheTipMassFrequencyEquation) {
 
 TEST(Cantilever, AxialAndTorsionalFrequenciesConverge) {
   const Case c = kane();
-  const Segment& seg = c.link.segments[0];
+  const Segment& seg = c.links[0].link.segments[0];
   for (const auto& [kind, name] : {std::pair{ModeKind::Axial, "axial"}, std::pair{ModeKind::Torsion, "torsion"}}) {
     for (int k = 1; k <= 2; ++k) {
       const Series s = series(c, std::string(name) + ":" + std::to_string(k));
@@ -106,7 +106,7 @@ TEST(Cantilever, AxialAndTorsionalFrequenciesConverge) {
 
 TEST(Cantilever, StaticTipDeflectionAndRotation) {
   const Case c = kane();  // 1 N tip force along −z: bending about y (Iy)
-  const Segment& seg = c.link.segments[0];
+  const Segment& seg = c.links[0].link.segments[0];
   const double P = -1.0;
   const Series w = series(c, "tip:uz", {10, 20, 40});
   const Series r = series(c, "tip:ry", {10, 20, 40});
@@ -161,7 +161,7 @@ TEST(Cantilever, ErrorAgainstTheTimoshenkoReferenceFallsAsOneOverNSquared) {
   // the first three modes in both planes; against Euler–Bernoulli it would stall at the shear
   // correction (as the printed error once did, growing with n).
   const Case c = kane();
-  const Segment& s = c.link.segments[0];
+  const Segment& s = c.links[0].link.segments[0];
   for (const char* kind : {"bending-y", "bending-z"})
     for (int k = 1; k <= 3; ++k) {
       const std::string q = std::string(kind) + ":" + std::to_string(k);
@@ -181,7 +181,7 @@ TEST(RotatingBeam, StaticStretchOfASpinningBar) {
   // displacement of a bar under its own centrifugal load, E u'' + ρΩ²(x + u) = 0, u(0) = u'(L) = 0:
   // u(L) = tan(kL)/k − L with k = Ω √(ρ/E) (5.1e-4 m at Ω = 6 rad/s). Order-2 convergence in n.
   const Case c = read_case(test::source_path("cases/kane_spinup.toml"));
-  const Segment& s = c.link.segments[0];
+  const Segment& s = c.links[0].link.segments[0];
   const double Omega = 6.0, k = Omega * std::sqrt(s.material.rho / s.material.E), L = s.length;
   const double exact = std::tan(k * L) / k - L;
   std::vector<double> u;
@@ -192,7 +192,7 @@ TEST(RotatingBeam, StaticStretchOfASpinningBar) {
     const Model m = build_model(c, n);
     VecX qb, vb;
     app::joint_state(c, o, qb, vb);
-    u.push_back(tip_motion(m, solve_static(m, qb, vb, TipLoads{}).q)[0]);
+    u.push_back(tip_motion(m, 0, solve_static(m, qb, vb, TipLoads{}).q)[0]);
   }
   const double p = std::log2(std::abs((u[1] - u[0]) / (u[2] - u[1])));
   const double rich = u[2] + (u[2] - u[1]) / (std::pow(2.0, p) - 1.0);
@@ -209,7 +209,7 @@ TEST(FreeJoints, BeamOnAFreeHubHasThePinnedFreeFrequencies) {
   // cantilever nearly vanishes); the vertical-plane bending does not couple to the hub and keeps
   // the cantilever's frequencies to the dense solver's round-off, 100 ε (ω_max/ω)².
   const Case c = read_case(test::source_path("cases/kane_spinup.toml"));
-  const Segment& seg = c.link.segments[0];
+  const Segment& seg = c.links[0].link.segments[0];
   const double unit = std::sqrt(seg.material.E * seg.section.Iz / (seg.material.rho * seg.section.A)) / (seg.length * seg.length);
   std::vector<Series> pinned(3);
   for (int n : {20, 40, 80}) {
@@ -251,15 +251,16 @@ TEST(FreeJoints, BeamOnAWeightlessFreeBaseHasTheFreeFreeFrequencies) {
   // as the pinned–free beam's) with Richardson within the Timoshenko bound; Lanczos agrees with
   // the dense solver.
   const Case c = kane();
-  const Segment& seg = c.link.segments[0];
+  const Segment& seg = c.links[0].link.segments[0];
   const double mass = seg.material.rho * seg.section.A * seg.length, tiny = 1e-9 * mass;
   Mat4 H = Mat4::Zero();
   H.diagonal() << tiny, tiny, tiny, tiny;  // a point-like bus of inertia ~ tiny · 1 m²
   std::vector<Series> y(2), z(2);
   for (int n : {20, 40, 80}) {
     Model m = build_model(c, n);
-    m = make_model(free_base_joints(H), m.mount, m.link, 0.0);
-    m.free_base = true;
+    std::vector<MountedLink> links = m.links;
+    links[0].on = Mounting{};  // on the last joint: the bus
+    m = make_model(free_base_joints(H), links, 0.0, true);
     const std::vector<int> all{0, 1, 2, 3, 4, 5};
     const VecX qb = VecX::Zero(6), vb = VecX::Zero(6);
     const ModesResult r = compute_modes(m, qb, vb, 12, 600, all);

@@ -63,8 +63,8 @@ TEST(CaseFile, ShippedCasesLoad) {
   EXPECT_EQ(pm.m(), 3);
   EXPECT_EQ(pm.n(), 6);
   // n = 6 over 2.667 m + 5.333 m: 2 + 4 parts, total mass ρ(A1 L1 + A2 L2).
-  double mass = pm.link.rfe0.mass;
-  for (const auto& r : pm.link.rfes) mass += r.mass;
+  double mass = pm.links[0].d.rfe0.mass;
+  for (const auto& r : pm.links[0].d.rfes) mass += r.mass;
   EXPECT_NEAR(mass, 2766.67 * (3.84e-4 * 2.667 + 7.3e-5 * 5.333), 1e-12);
 }
 
@@ -72,8 +72,8 @@ TEST(CaseFile, OverridesApply) {
   const std::string path = write_case("good.toml", kGood);
   const Case c = read_case(path, {"link.n=10", "sections.s.Iy=3e-7", "link.segments.0.length=4"});
   EXPECT_EQ(build_model(c).n(), 10);
-  EXPECT_DOUBLE_EQ(c.link.segments[0].section.Iy, 3e-7);
-  EXPECT_DOUBLE_EQ(c.link.segments[0].length, 4.0);
+  EXPECT_DOUBLE_EQ(c.links[0].link.segments[0].section.Iy, 3e-7);
+  EXPECT_DOUBLE_EQ(c.links[0].link.segments[0].length, 4.0);
 }
 
 TEST(CaseFile, BadInputNamesFileLineAndKey) {

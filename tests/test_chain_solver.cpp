@@ -1,6 +1,7 @@
 // The block Cholesky of the bordered chain (solvers/chain_solver.hpp) against a dense solve, for
 // every shape the split can take (no rfes, one, two, odd and even chains, with and without a
-// border), and bit-identical results with the two sweeps on one and on two threads.
+// border, several chains each with its own border columns), and bit-identical results with the
+// sweeps on one and on two threads.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -90,4 +91,75 @@ TEST(ChainSolver, OneAndTwoThreadsAreBitIdentical) {
     cs.solve(x[t - 1]);
   }
   EXPECT_EQ((x[0] - x[1]).cwiseAbs().maxCoeff(), 0.0);
+}
+
+namespace {
+// Chains of 4, 1 and 7 blocks over a border of 5, each with its own columns (one with none).
+BorderedPattern several_chains() {
+  std::vector<BorderedPattern::Chain> chains(3);
+  chains[0] = {0, 4, {0, 2}};
+  chains[1] = {4, 1, {}};
+  chains[2] = {5, 7, {1, 2, 3, 4}};
+  return BorderedPattern(chains, 5);
+}
+}  // namespace
+
+TEST(ChainSolver, SeveralChainsWithTheirOwnBordersEqualDenseSolve) {
+  const BorderedPattern p = several_chains();
+  EXPECT_EQ(p.slot(0, 6 * 12 + 1), -1) << "chain 0 is not coupled to border column 1";
+  EXPECT_EQ(p.slot(6 * 3, 6 * 4), -1) << "chains are not coupled to each other";
+  EXPECT_EQ(static_cast<long>(p.csc().rowind.size()), p.entries());
+  const auto v0 = random_spd(p, 29);
+  const MatX A = to_dense(p, v0);
+  const VecX b = VecX::LinSpaced(p.size(), -1.0, 2.0), ref = A.ldlt().solve(b);
+  VecX x[2];
+  for (int t : {1, 2}) {
+    std::vector<double> v = v0;
+    ChainSolver cs(p);
+    cs.set_threads(t);
+    ASSERT_TRUE(cs.factorize(v));
+    x[t - 1] = b;
+    cs.solve(x[t - 1]);
+    EXPECT_LT((x[t - 1] - ref).norm(), 1e-13 * ref.norm()) << t << " thread(s)";
+  }
+  EXPECT_EQ((x[0] - x[1]).cwiseAbs().maxCoeff(), 0.0);
+  std::vector<double> v = v0;
+  CholmodSolver cholmod(p);
+  ASSERT_TRUE(cholmod.factorize(v));
+  VecX y = b;
+  cholmod.solve(y);
+  EXPECT_LT((y - ref).norm(), 1e-12 * ref.norm());
+}
+
+TEST(ChainSolver, MatchesCholmodOnATreeNewtonMatrix) {
+  // A tree of links and joints (test::tree_arm): four rfes carry joints or a link, so there are
+  // five chains (A and B are cut in two, C is one), their borders hold different joints and
+  // carrying rfes.
+  const Model m = test::tree_arm(6, 2e-3);
+  VecX q, v, a;
+  test::random_state(m, 8, q, v, a);
+  q.head(m.flexible_dofs()) *= 1e-3;
+  std::vector<int> cols(m.m(), -1);
+  cols[0] = m.flexible_dofs();
+  cols[2] = m.flexible_dofs() + 1;  // shoulder and wrist free, elbow and slider prescribed
+  const BorderedPattern p(m, cols);
+  EXPECT_EQ(p.chains().size(), 5u);
+  EXPECT_EQ(p.n_base(), 6 * m.carrying + 2);
+  for (double h : {1e-4, 1e-2}) {
+    MatrixTerms t;
+    t.mass = 1.0;
+    t.damping = h;
+    t.stiffness = h * h;
+    t.gravity = true;
+    std::vector<double> values;
+    assemble_matrix(m, p, cols, q, v, t, values);
+    ChainSolver chain(p);
+    CholmodSolver cholmod(p);
+    ASSERT_TRUE(cholmod.factorize(values));
+    ASSERT_TRUE(chain.factorize(values));
+    VecX x1 = VecX::LinSpaced(p.size(), 1.0, -1.0), x2 = x1;
+    chain.solve(x1);
+    cholmod.solve(x2);
+    EXPECT_LT((x1 - x2).norm(), 1e-10 * x2.norm()) << "h = " << h;
+  }
 }

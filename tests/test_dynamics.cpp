@@ -269,7 +269,7 @@ TEST(Dynamics, SchurSolveEqualsDenseSolveOfFullNewtonSystem) {
   test::random_state(m, 31, q, v, a);
   q.head(m.flexible_dofs()) *= 1e-3;  // a physical deformation: the random 5 cm would buckle the axial springs
   const int N = m.dof();
-  NewtonSystem ns(m, {m.flexible_dofs(), m.joint_index(1)}, 2, LinearSolverKind::Chain, nullptr, true);
+  NewtonSystem ns(m, {m.flexible_dofs(), m.joint_index(1)}, LinearSolverKind::Chain, nullptr, true);
   const double c = 350.0;
   ASSERT_TRUE(ns.setup(q, v, 1.0 / c));
   const MatX M = dense_mass_matrix(m, q), C = dense_damping(m, q, v), K = dense_stiffness(m, q, false);

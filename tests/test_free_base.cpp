@@ -97,7 +97,7 @@ TEST(FreeBase, MomentumIsTheGeneralisedMomentumOfTheBaseCoordinates) {
   const VecX Mv = to_dense(p, vals) * v;
   const Momentum P = momentum(m, q, v);
   BaseKinematics bk;
-  base_kinematics(m, q.tail(m.m()), v.tail(m.m()), VecX::Zero(m.m()), bk);
+  base_kinematics(m, q, v, VecX::Zero(m.dof()), bk);
   const double scale = P.linear.norm() + P.angular.norm();
   ASSERT_GT(scale, 1.0);
   for (int j = 0; j < free_base_dofs; ++j) {

@@ -98,7 +98,7 @@ TEST(Integrator, DefaultTolerancesMeetTheAccuracyTarget) {
     const bool kinematic = inputs == &laws;
     double err[4] = {0, 0, 0, 0}, peak[4] = {0, 0, 0, 0};
     for (size_t i = 0; i < run[0].size(); ++i) {
-      const Vec6 a = tip_motion(flex, run[0][i].q), b = tip_motion(flex, run[1][i].q);
+      const Vec6 a = tip_motion(flex, 0, run[0][i].q), b = tip_motion(flex, 0, run[1][i].q);
       const double xa[4] = {a[1], a[2], a[3], run[0][i].tau[2]}, xb[4] = {b[1], b[2], b[3], run[1][i].tau[2]};
       for (int k = 0; k < 4; ++k) {
         err[k] = std::max(err[k], std::abs(xa[k] - xb[k]));

@@ -54,9 +54,9 @@ ForceTerms only(bool inertia, bool gravity, bool sde) {
 }
 
 MatX assembled(const Model& m, const VecX& q, const VecX& v, const MatrixTerms& t) {
-  const BorderedPattern p(m.n(), m.m());
   std::vector<int> cols(m.m());
   for (int j = 0; j < m.m(); ++j) cols[j] = m.joint_index(j);
+  const BorderedPattern p(m, cols);
   std::vector<double> vals;
   assemble_matrix(m, p, cols, q, v, t, vals);
   return to_dense(p, vals);
@@ -253,14 +253,47 @@ TEST(KernelsFD, TipForceDoesVirtualWork) {
   TipLoads loads;
   loads.force = Vec3(1.0, -2.0, 3.0);
   const int n = m.n();
-  const Vec6 Q = tip_generalised_force(m, q.segment<6>(6 * (n - 1)), loads);
+  const Vec6 Q = tip_generalised_force(m, 0, q.segment<6>(6 * (n - 1)), loads);
   // Q_j = F · ∂p_tip/∂q_j
   const VecX g = fd_gradient(
       [&](const VecX& x) {
         VecX qq = q;
         qq.segment<6>(6 * (n - 1)) = x;
-        return loads.force.dot(tip_motion(m, qq).head<3>());
+        return loads.force.dot(tip_motion(m, 0, qq).head<3>());
       },
       VecX(q.segment<6>(6 * (n - 1))));
   EXPECT_LT((Q - g).norm(), 1e-8 * Q.norm());
+}
+
+TEST(KernelsFD, TreeOfLinksJointsAndPayloadsIsConsistent) {
+  // Every kind of mounting at once (test::tree_arm: a joint on a link's tip, a wrist with an end
+  // effector, a slider mid-link, a link fixed to another, payloads, gravity, damping): bodies beyond
+  // an rfe move with its six coordinates, so every invariant above must hold for the whole tree.
+  const Model m = test::tree_arm(2, 0.01);
+  ASSERT_EQ(m.carrying, 4);
+  VecX q, v, a;
+  test::random_state(m, 21, q, v, a);
+  const MatX M = expect_mass_is_hessian_of_kinetic_energy(m, q, v);
+  Eigen::SelfAdjointEigenSolver<MatX> es(M);
+  EXPECT_GT(es.eigenvalues().minCoeff(), 0.0) << "M must be positive definite";
+  expect_inertial_force_satisfies_lagrange(m, q, v, a);
+  expect_damping_is_jacobian_of_dissipative_forces(m, q, v);
+  const VecX zero = VecX::Zero(m.dof());
+  VecX fe, fg;
+  generalised_forces(m, q, zero, zero, only(false, false, true), fe);
+  generalised_forces(m, q, zero, zero, only(false, true, false), fg);
+  EXPECT_LT(rel(fe, fd_gradient([&](const VecX& x) { return energies(m, x, zero).elastic; }, q)), 1e-6);
+  EXPECT_LT(rel(fg, fd_gradient([&](const VecX& x) { return energies(m, x, zero).gravity; }, q)), 1e-6);
+  MatrixTerms t;
+  t.stiffness = 1.0;
+  t.gravity = true;
+  const MatX Kfd = fd_jacobian(
+      [&](const VecX& x) {
+        VecX f;
+        generalised_forces(m, x, zero, zero, only(false, true, true), f);
+        return f;
+      },
+      q);
+  EXPECT_LT(rel(assembled(m, q, zero, t), Kfd), 1e-6);
+  EXPECT_LT(rel(dense_stiffness(m, q, true), Kfd), 1e-6);
 }

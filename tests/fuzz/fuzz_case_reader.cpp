@@ -21,12 +21,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   try {
     const rfem::Case c = rfem::read_case(path, overrides);
-    if (c.has_link) {
-      // Keep models small: the fuzzer is after the reader, not big allocations.
-      int parts = 0;
-      for (const auto& s : c.link.segments) parts += s.parts;
-      if (c.n <= 64 && parts <= 64) rfem::build_model(c);
+    // Keep models small: the fuzzer is after the reader, not big allocations.
+    int parts = 0, n = 0;
+    for (const auto& l : c.links) {
+      n += l.n;
+      for (const auto& s : l.link.segments) parts += s.parts;
     }
+    if (n <= 64 && parts <= 64) rfem::build_model(c);
   } catch (const rfem::CaseError&) {
   }
   return 0;

@@ -1,0 +1,210 @@
+#pragma once
+// The case reader's private parts (cases/case_file.hpp is the interface): typed reading of TOML
+// values with file, line and key in every message, and the readers of each part of a case.
+#include <toml++/toml.h>
+
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cases/case_file.hpp"
+
+namespace rfem::reading {
+
+constexpr long kMaxRfes = 10000000;  // far beyond memory; guards int overflow of n and parts
+
+// Reads typed values from a toml table with the file, line and dotted key in every error.
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const toml::node* node, const std::string& key, const std::string& what) const {
+    std::ostringstream os;
+    os << file_;
+    if (node && node->source().begin.line > 0) os << ":" << node->source().begin.line;
+    else os << " (--set or missing)";
+    os << ": " << key << ": " << what;
+    throw CaseError(os.str());
+  }
+
+  /// A legal but suspicious value: a one-line warning naming file, line and key.
+  void warn(const toml::node* node, const std::string& key, const std::string& what) const {
+    std::ostringstream os;
+    os << file_;
+    if (node && node->source().begin.line > 0) os << ":" << node->source().begin.line;
+    os << ": " << key << ": " << what;
+    warnings_.push_back(os.str());
+  }
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+  /// An angle [rad]: a number (radians), or a string "90 deg" / "1.5 rad". A plain number beyond
+  /// ±2π is taken as radians but warned about (TOML has no π; degrees are a common slip).
+  double angle(const toml::table& t, const std::string& path, const std::string& key, double dflt) const {
+    const toml::node* n = t.get(key);
+    const std::string k = join(path, key);
+    if (!n) return dflt;
+    if (auto s = n->as_string()) {
+      std::istringstream is(s->get());
+      double v = 0.0;
+      std::string unit;
+      if (!(is >> v) || !(is >> unit) || (unit != "deg" && unit != "rad") || !std::isfinite(v))
+        fail(n, k, "an angle is a number (radians) or a string \"<number> deg\" or \"<number> rad\" (got \"" + s->get() + "\")");
+      return unit == "deg" ? v * M_PI / 180.0 : v;
+    }
+    const double v = number(t, path, key, dflt);
+    if (std::abs(v) > 2 * M_PI + 1e-9)
+      warn(n, k, "|" + fmt(v) + "| rad is more than a turn: if degrees were meant, write \"" + fmt(v) + " deg\"");
+    return v;
+  }
+
+  void check_keys(const toml::table& t, const std::string& path, const std::set<std::string>& allowed) const {
+    for (const auto& [k, v] : t)
+      if (!allowed.count(std::string(k.str()))) {
+        std::string list;
+        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        fail(&v, join(path, std::string(k.str())), "unknown key (allowed: " + list + ")");
+      }
+  }
+
+  const toml::table& table(const toml::table& t, const std::string& path, const std::string& key) const {
+    const toml::node* n = t.get(key);
+    if (!n) fail(&t, join(path, key), "missing table");
+    if (!n->is_table()) fail(n, join(path, key), "must be a table");
+    return *n->as_table();
+  }
+
+  double number(const toml::table& t, const std::string& path, const std::string& key,
+                std::optional<double> dflt = std::nullopt) const {
+    const toml::node* n = t.get(key);
+    const std::string k = join(path, key);
+    if (!n) {
+      if (dflt) return *dflt;
+      fail(&t, k, "missing (a number is required)");
+    }
+    double v;
+    if (auto f = n->as_floating_point()) v = f->get();
+    else if (auto i = n->as_integer()) v = static_cast<double>(i->get());
+    else fail(n, k, std::string("must be a number, not ") + type_name(*n));
+    if (!std::isfinite(v)) fail(n, k, "must be finite (got " + std::to_string(v) + ")");
+    return v;
+  }
+
+  double positive(const toml::table& t, const std::string& path, const std::string& key,
+                  std::optional<double> dflt = std::nullopt) const {
+    const double v = number(t, path, key, dflt);
+    if (!(v > 0.0)) fail(t.get(key) ? t.get(key) : &t, join(path, key), "must be positive (got " + fmt(v) + ")");
+    return v;
+  }
+
+  double non_negative(const toml::table& t, const std::string& path, const std::string& key, double dflt) const {
+    const double v = number(t, path, key, dflt);
+    if (v < 0.0) fail(t.get(key), join(path, key), "must not be negative (got " + fmt(v) + ")");
+    return v;
+  }
+
+  long integer(const toml::table& t, const std::string& path, const std::string& key, long dflt, long min,
+               long max) const {
+    const toml::node* n = t.get(key);
+    if (!n) return dflt;
+    auto i = n->as_integer();
+    if (!i) fail(n, join(path, key), std::string("must be an integer, not ") + type_name(*n));
+    if (i->get() < min) fail(n, join(path, key), "must be at least " + std::to_string(min) + " (got " + std::to_string(i->get()) + ")");
+    if (i->get() > max) fail(n, join(path, key), "must be at most " + std::to_string(max) + " (got " + std::to_string(i->get()) + ")");
+    return static_cast<long>(i->get());
+  }
+
+  std::string string(const toml::table& t, const std::string& path, const std::string& key,
+                     std::optional<std::string> dflt = std::nullopt) const {
+    const toml::node* n = t.get(key);
+    if (!n) {
+      if (dflt) return *dflt;
+      fail(&t, join(path, key), "missing (a string is required)");
+    }
+    auto s = n->as_string();
+    if (!s) fail(n, join(path, key), std::string("must be a string, not ") + type_name(*n));
+    return s->get();
+  }
+
+  Vec3 vec3(const toml::table& t, const std::string& path, const std::string& key, Vec3 dflt) const {
+    const toml::node* n = t.get(key);
+    if (!n) return dflt;
+    auto a = n->as_array();
+    if (!a || a->size() != 3) fail(n, join(path, key), "must be an array of three numbers");
+    Vec3 v;
+    for (int i = 0; i < 3; ++i) {
+      const toml::node& e = *a->get(i);
+      if (auto f = e.as_floating_point()) v[i] = f->get();
+      else if (auto x = e.as_integer()) v[i] = static_cast<double>(x->get());
+      else fail(&e, join(path, key), "must be an array of three numbers");
+      if (!std::isfinite(v[i])) fail(&e, join(path, key), "must be finite");
+    }
+    return v;
+  }
+
+  static std::string join(const std::string& a, const std::string& b) { return a.empty() ? b : a + "." + b; }
+  mutable std::vector<std::string> warnings_;
+  static std::string fmt(double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+  }
+  static const char* type_name(const toml::node& n) {
+    switch (n.type()) {
+      case toml::node_type::table: return "a table";
+      case toml::node_type::array: return "an array";
+      case toml::node_type::string: return "a string";
+      case toml::node_type::integer: return "an integer";
+      case toml::node_type::floating_point: return "a float";
+      case toml::node_type::boolean: return "a boolean";
+      default: return "a date/time";
+    }
+  }
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+};
+
+
+using Materials = std::map<std::string, Material>;
+using Sections = std::map<std::string, Section>;
+
+/// A constant transform {xyz, rpy} (translation, then roll–pitch–yaw angles).
+Mat4 transform(const Reader& r, const toml::table& t, const std::string& path);
+/// The named tables [materials.*] and [sections.*].
+Materials read_materials(const Reader& r, const toml::table& root);
+Sections read_sections(const Reader& r, const toml::table& root);
+/// A rigid body {mass, com, inertia} or {section, material, length}; `extra` names keys the caller
+/// reads itself (a payload's `at`).
+Mat4 read_body(const Reader& r, const toml::table& t, const std::string& path, const Materials& mats,
+               const Sections& secs, const std::set<std::string>& extra = {});
+JointDrive read_drive(const Reader& r, const toml::table& t, const std::string& path);
+InputSpec read_input(const Reader& r, const toml::table& t, const std::string& path, const std::string& case_dir);
+
+/// What a joint or a link names as its parent, kept until every name is known.
+struct ParentRef {
+  std::string name;                  ///< "" : the default
+  const toml::node* node = nullptr;  ///< the `parent` value (or the element's table) for messages
+  std::string path;                  ///< "joints.2" / "links.0"
+  const toml::node* at = nullptr;    ///< the `at` value, if given
+  Mat4 X = Mat4::Identity();         ///< `mount`
+};
+
+/// [[joints]] into c.joints, c.inputs, c.joint_values/rates; their parents into `parents`.
+void read_joints(const Reader& r, const toml::table& root, const Materials& mats, const Sections& secs,
+                 const std::string& case_dir, Case& c, std::vector<ParentRef>& parents);
+/// [base] kind = "free": six joints ahead of the case's (with parents that need no names).
+void read_base(const Reader& r, const toml::node* bn, const Materials& mats, const Sections& secs,
+               const std::string& path, Case& c, std::vector<ParentRef>& parents);
+/// [link] (one link) or [[links]] into c.links; their parents into `parents`.
+void read_links(const Reader& r, const toml::table& root, const Materials& mats, const Sections& secs, Case& c,
+                std::vector<ParentRef>& parents);
+/// Resolves every parent name into the Mountings of c.joints and c.links, checks names are unique,
+/// points lie on their links and the mountings form no cycle.
+void resolve_mountings(const Reader& r, Case& c, const std::vector<ParentRef>& joint_parents,
+                       const std::vector<ParentRef>& link_parents);
+
+}  // namespace rfem::reading

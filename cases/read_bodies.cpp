@@ -1,0 +1,144 @@
+// Materials, sections, rigid bodies and joint drives of a case file.
+#include <cmath>
+
+#include "cases/case_reading.hpp"
+#include "core/rotation.hpp"
+
+namespace rfem::reading {
+
+Mat4 transform(const Reader& r, const toml::table& t, const std::string& path) {
+  r.check_keys(t, path, {"xyz", "rpy"});
+  return homogeneous(rot_rpy(r.vec3(t, path, "rpy", Vec3::Zero())), r.vec3(t, path, "xyz", Vec3::Zero()));
+}
+
+namespace {
+
+Material read_material(const Reader& r, const toml::table& t, const std::string& path, const std::string& name) {
+  r.check_keys(t, path, {"E", "G", "rho"});
+  Material m;
+  m.name = name;
+  m.E = r.positive(t, path, "E");
+  m.G = r.positive(t, path, "G");
+  m.rho = r.positive(t, path, "rho");
+  if (m.G > m.E / 2)
+    r.warn(t.get("G"), path + ".G", "G > E/2 means a negative Poisson's ratio (nu = E/2G - 1 = " + Reader::fmt(m.E / (2 * m.G) - 1) + ")");
+  if (m.E < 1e5) r.warn(t.get("E"), path + ".E", "E = " + Reader::fmt(m.E) + " Pa is very small: units are SI (Pa), not GPa or MPa");
+  if (m.rho < 10) r.warn(t.get("rho"), path + ".rho", "rho = " + Reader::fmt(m.rho) + " kg/m^3 is very small: units are SI (kg/m^3), not g/cm^3");
+  return m;
+}
+
+Section read_section(const Reader& r, const toml::table& t, const std::string& path, const std::string& name) {
+  if (t.get("box")) {
+    r.check_keys(t, path, {"box", "kappa_y", "kappa_z"});
+    const toml::table& b = r.table(t, path, "box");
+    const std::string bp = path + ".box";
+    r.check_keys(b, bp, {"outer", "inner"});
+    const double outer = r.positive(b, bp, "outer"), inner = r.non_negative(b, bp, "inner", 0.0);
+    if (inner >= outer) r.fail(b.get("inner"), bp + ".inner", "must be smaller than outer");
+    Section s = box_section(name, outer, inner);
+    s.kappa_y = r.positive(t, path, "kappa_y", s.kappa_y);
+    s.kappa_z = r.positive(t, path, "kappa_z", s.kappa_z);
+    return s;
+  }
+  r.check_keys(t, path, {"A", "Iy", "Iz", "J", "kappa_y", "kappa_z", "offset_y", "offset_z"});
+  Section s;
+  s.name = name;
+  s.A = r.positive(t, path, "A");
+  s.Iy = r.positive(t, path, "Iy");
+  s.Iz = r.positive(t, path, "Iz");
+  s.J = r.positive(t, path, "J");
+  s.kappa_y = r.positive(t, path, "kappa_y", 5.0 / 6.0);
+  s.kappa_z = r.positive(t, path, "kappa_z", 5.0 / 6.0);
+  s.offset = Vec3(0.0, r.number(t, path, "offset_y", 0.0), r.number(t, path, "offset_z", 0.0));
+  for (const char* k : {"Iy", "Iz"}) {
+    const double I = k[1] == 'y' ? s.Iy : s.Iz;
+    // A thin tube of radius ρ and wall t has I/A² = ρ/(4πt): 10 A² is a wall of ρ/125 (Kane's beam,
+    // a real one, has I = 1.25 A²).
+    if (I > 10 * s.A * s.A)
+      r.warn(t.get(k), path + "." + k, "a second moment of 10 A^2 or more (" + Reader::fmt(I) + " m^4 against A^2 = " +
+                                           Reader::fmt(s.A * s.A) + " m^4) needs an extremely thin wall: check the units (m^4, m^2)");
+  }
+  if (s.J > 1.0001 * (s.Iy + s.Iz))
+    r.warn(t.get("J"), path + ".J", "a torsion constant larger than Iy + Iz is impossible for a real section");
+  return s;
+}
+
+template <class T>
+std::map<std::string, T> read_named(const Reader& r, const toml::table& root, const std::string& key,
+                                    T (*read)(const Reader&, const toml::table&, const std::string&, const std::string&)) {
+  std::map<std::string, T> out;
+  const toml::node* n = root.get(key);
+  if (!n) return out;
+  if (!n->is_table()) r.fail(n, key, "must be a table of named entries");
+  for (const auto& [k, v] : *n->as_table()) {
+    const std::string path = key + "." + std::string(k.str());
+    if (!v.is_table()) r.fail(&v, path, "must be a table");
+    out.emplace(std::string(k.str()), read(r, *v.as_table(), path, std::string(k.str())));
+  }
+  return out;
+}
+
+}  // namespace
+
+Materials read_materials(const Reader& r, const toml::table& root) {
+  return read_named<Material>(r, root, "materials", read_material);
+}
+
+Sections read_sections(const Reader& r, const toml::table& root) {
+  return read_named<Section>(r, root, "sections", read_section);
+}
+
+Mat4 read_body(const Reader& r, const toml::table& t, const std::string& path, const Materials& mats,
+               const Sections& secs, const std::set<std::string>& extra) {
+  if (t.get("section")) {
+    // Uniform prismatic link along its frame's x axis from the origin.
+    std::set<std::string> keys{"section", "material", "length"};
+    keys.insert(extra.begin(), extra.end());
+    r.check_keys(t, path, keys);
+    const std::string sn = r.string(t, path, "section"), mn = r.string(t, path, "material");
+    if (!secs.count(sn)) r.fail(t.get("section"), path + ".section", "no section named '" + sn + "'");
+    if (!mats.count(mn)) r.fail(t.get("material"), path + ".material", "no material named '" + mn + "'");
+    const double L = r.positive(t, path, "length");
+    const Section& s = secs.at(sn);
+    const double rho = mats.at(mn).rho, mass = rho * s.A * L;
+    Mat3 I = Mat3::Zero();  // about the mass centre; Ixx from the polar second moment
+    I(0, 0) = rho * L * (s.Iy + s.Iz);
+    I(1, 1) = mass * L * L / 12.0 + rho * L * s.Iy;
+    I(2, 2) = mass * L * L / 12.0 + rho * L * s.Iz;
+    return pseudo_inertia(mass, Vec3(0.5 * L, 0, 0), I);
+  }
+  std::set<std::string> keys{"mass", "com", "inertia"};
+  keys.insert(extra.begin(), extra.end());
+  r.check_keys(t, path, keys);
+  const double mass = r.non_negative(t, path, "mass", 0.0);
+  const Vec3 com = r.vec3(t, path, "com", Vec3::Zero());
+  Mat3 I = Mat3::Zero();
+  if (const toml::node* n = t.get("inertia")) {
+    auto a = n->as_array();
+    if (!a || a->size() != 6) r.fail(n, path + ".inertia", "must be [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]");
+    double v[6];
+    for (int i = 0; i < 6; ++i) {
+      const toml::node& e = *a->get(i);
+      if (auto f = e.as_floating_point()) v[i] = f->get();
+      else if (auto x = e.as_integer()) v[i] = static_cast<double>(x->get());
+      else r.fail(&e, path + ".inertia", "must be six numbers");
+      if (!std::isfinite(v[i])) r.fail(&e, path + ".inertia", "must be finite");
+    }
+    I << v[0], v[3], v[4], v[3], v[1], v[5], v[4], v[5], v[2];
+    if (I.selfadjointView<Eigen::Upper>().eigenvalues().minCoeff() < 0.0 || v[0] + v[1] < v[2] ||
+        v[1] + v[2] < v[0] || v[0] + v[2] < v[1])
+      r.fail(n, path + ".inertia", "is not a physical inertia tensor");
+  }
+  return pseudo_inertia(mass, com, I);
+}
+
+JointDrive read_drive(const Reader& r, const toml::table& t, const std::string& path) {
+  r.check_keys(t, path, {"inertia", "damping", "friction", "friction_velocity"});
+  JointDrive d;
+  d.inertia = r.non_negative(t, path, "inertia", d.inertia);
+  d.damping = r.non_negative(t, path, "damping", d.damping);
+  d.friction = r.non_negative(t, path, "friction", d.friction);
+  d.friction_velocity = r.positive(t, path, "friction_velocity", d.friction_velocity);
+  return d;
+}
+}  // namespace rfem::reading

@@ -1,0 +1,176 @@
+// Flexible links of a case file ([link] or [[links]]) and what every joint and link is mounted on.
+#include <algorithm>
+#include <cmath>
+
+#include "cases/case_reading.hpp"
+
+namespace rfem::reading {
+
+namespace {
+
+LinkCase read_link(const Reader& r, const toml::table& lt, const std::string& key, const std::string& name,
+                   const Materials& mats, const Sections& secs, ParentRef& parent) {
+  r.check_keys(lt, key, {"name", "parent", "at", "n", "damping_beta", "mount", "segments", "payloads"});
+  LinkCase c;
+  c.key = key;
+  c.name = r.string(lt, key, "name", name);
+  c.n = static_cast<int>(r.integer(lt, key, "n", 0, 1, kMaxRfes));
+  c.link.damping_beta = r.non_negative(lt, key, "damping_beta", 0.0);
+  parent.path = key;
+  parent.node = lt.get("parent") ? lt.get("parent") : &lt;
+  parent.name = r.string(lt, key, "parent", std::string());
+  parent.at = lt.get("at");
+  if (const toml::node* mn = lt.get("mount")) {
+    if (!mn->is_table()) r.fail(mn, key + ".mount", "must be a table {xyz, rpy}");
+    parent.X = transform(r, *mn->as_table(), key + ".mount");
+  }
+  const toml::node* sn = lt.get("segments");
+  if (!sn) r.fail(&lt, key + ".segments", "missing: a link needs at least one segment");
+  auto arr = sn->as_array();
+  if (!arr || arr->empty() || !arr->is_array_of_tables())
+    r.fail(sn, key + ".segments", "must be a non-empty array of tables ([[" + key.substr(0, key.find('.')) + ".segments]])");
+  for (size_t i = 0; i < arr->size(); ++i) {
+    const toml::table& st = *arr->get(i)->as_table();
+    const std::string p = key + ".segments." + std::to_string(i);
+    r.check_keys(st, p, {"length", "material", "section", "parts"});
+    Segment s;
+    s.length = r.positive(st, p, "length");
+    const std::string mn = r.string(st, p, "material"), sc = r.string(st, p, "section");
+    if (!mats.count(mn)) r.fail(st.get("material"), p + ".material", "no material named '" + mn + "'");
+    if (!secs.count(sc)) r.fail(st.get("section"), p + ".section", "no section named '" + sc + "'");
+    s.material = mats.at(mn);
+    s.section = secs.at(sc);
+    if (!st.get("parts") && c.n == 0) r.fail(&st, p + ".parts", "missing (give parts per segment or " + key + ".n)");
+    s.parts = static_cast<int>(r.integer(st, p, "parts", 1, 1, kMaxRfes));
+    c.link.segments.push_back(s);
+  }
+  if (const toml::node* pn = lt.get("payloads")) {
+    auto pa = pn->as_array();
+    if (!pa || !pa->is_array_of_tables()) r.fail(pn, key + ".payloads", "must be an array of tables ([[" + key + ".payloads]])");
+    const double L = c.link.total_length();
+    for (size_t i = 0; i < pa->size(); ++i) {
+      const toml::table& pt = *pa->get(i)->as_table();
+      const std::string p = key + ".payloads." + std::to_string(i);
+      Payload pl;
+      if (const toml::node* an = pt.get("at"); an && an->is_string() && an->as_string()->get() == "tip") pl.at = L;
+      else pl.at = r.number(pt, p, "at");
+      if (pl.at < 0.0 || pl.at > L * (1 + 1e-12))
+        r.fail(pt.get("at"), p + ".at", "must lie on the link, 0 to " + Reader::fmt(L) + " m, or be \"tip\" (got " + Reader::fmt(pl.at) + ")");
+      pl.at = std::min(pl.at, L);
+      pl.H = read_body(r, pt, p, mats, secs, {"at"});
+      if (pl.H(3, 3) <= 0.0) r.fail(&pt, p + ".mass", "a payload needs a positive mass");
+      c.link.payloads.push_back(pl);
+    }
+  }
+  if (c.n > 0 && c.n < static_cast<int>(c.link.segments.size()))
+    r.fail(lt.get("n"), key + ".n", "n = " + std::to_string(c.n) + " cannot cover " +
+                                        std::to_string(c.link.segments.size()) + " segments (one part each at least)");
+  return c;
+}
+
+// A joint's or link's parent as an entity: a joint, a link, or the ground (kind Ground).
+struct Entity {
+  Mounting::Kind kind = Mounting::Kind::Ground;
+  int index = -1;
+};
+
+}  // namespace
+
+void read_links(const Reader& r, const toml::table& root, const Materials& mats, const Sections& secs, Case& c,
+                std::vector<ParentRef>& parents) {
+  const toml::node* one = root.get("link");
+  const toml::node* many = root.get("links");
+  if (one && many) r.fail(many, "links", "give one flexible link as [link] or several as [[links]], not both");
+  if (one) {
+    if (!one->is_table()) r.fail(one, "link", "must be a table");
+    parents.emplace_back();
+    c.links.push_back(read_link(r, *one->as_table(), "link", "link", mats, secs, parents.back()));
+  }
+  if (many) {
+    auto arr = many->as_array();
+    if (!arr || arr->empty() || !arr->is_array_of_tables()) r.fail(many, "links", "must be a non-empty array of tables ([[links]])");
+    for (size_t i = 0; i < arr->size(); ++i) {
+      parents.emplace_back();
+      c.links.push_back(read_link(r, *arr->get(i)->as_table(), "links." + std::to_string(i),
+                                  "link" + std::to_string(i + 1), mats, secs, parents.back()));
+    }
+  }
+}
+
+void resolve_mountings(const Reader& r, Case& c, const std::vector<ParentRef>& joint_parents,
+                       const std::vector<ParentRef>& link_parents) {
+  const int m = static_cast<int>(c.joints.size()), nl = static_cast<int>(c.links.size());
+  // Names: unique among joints and links, and not "ground".
+  std::map<std::string, Entity> named;
+  auto name_of = [&](const Entity& e) { return e.kind == Mounting::Kind::Joint ? c.joints[e.index].name : c.links[e.index].name; };
+  auto add = [&](const std::string& name, const Entity& e, const ParentRef& pr) {
+    const std::string key = pr.path == "base" ? "base" : pr.path + ".name";
+    if (name == "ground") r.fail(pr.node, key, "'ground' is reserved for the inertial frame");
+    if (auto it = named.find(name); it != named.end())
+      r.fail(pr.node, key, "'" + name + "' names " + (it->second.kind == Mounting::Kind::Joint ? "a joint" : "a link") +
+                               " already (names must be unique among joints and links)");
+    named[name] = e;
+  };
+  for (int j = 0; j < m; ++j) add(c.joints[j].name, {Mounting::Kind::Joint, j}, joint_parents[j]);
+  for (int l = 0; l < nl; ++l) add(c.links[l].name, {Mounting::Kind::Link, l}, link_parents[l]);
+  auto mounting = [&](const ParentRef& pr, bool joint) {
+    Mounting on;
+    on.X = pr.X;
+    if (pr.name.empty()) {
+      if (!joint && nl > 1)
+        r.fail(pr.node, pr.path + ".parent", "missing: with several links each names its parent (a joint, a link or \"ground\")");
+      on.kind = Mounting::Kind::Chain;
+    } else if (pr.name == "ground") {
+      on.kind = Mounting::Kind::Ground;
+    } else {
+      const auto it = named.find(pr.name);
+      if (it == named.end()) {
+        std::string list;
+        for (const auto& [k, e] : named) list += (list.empty() ? "" : ", ") + k;
+        r.fail(pr.node, pr.path + ".parent", "no joint or link named '" + pr.name + "' (" + list + ", or \"ground\")");
+      }
+      on.kind = it->second.kind;
+      on.index = it->second.index;
+    }
+    if (pr.at) {
+      if (on.kind != Mounting::Kind::Link)
+        r.fail(pr.at, pr.path + ".at", "applies to something mounted on a link only (its parent is not a link)");
+      const double L = c.links[on.index].link.total_length();
+      if (pr.at->is_string() && pr.at->as_string()->get() == "tip") on.at = L;
+      else if (auto f = pr.at->value<double>()) on.at = *f;
+      else r.fail(pr.at, pr.path + ".at", "must be a position along the link [m] or \"tip\"");
+      if (!std::isfinite(on.at) || on.at < 0.0 || on.at > L * (1 + 1e-12))
+        r.fail(pr.at, pr.path + ".at", "must lie on link '" + c.links[on.index].name + "', 0 to " + Reader::fmt(L) +
+                                           " m, or be \"tip\" (got " + Reader::fmt(on.at) + ")");
+      on.at = std::min(on.at, L);
+    } else if (on.kind == Mounting::Kind::Link) {
+      on.at = c.links[on.index].link.total_length();
+    }
+    return on;
+  };
+  for (int j = 0; j < m; ++j) c.joints[j].on = mounting(joint_parents[j], true);
+  for (int l = 0; l < nl; ++l) c.links[l].on = mounting(link_parents[l], false);
+  // No cycles: from every joint and link, the parents lead to the ground.
+  auto parent = [&](const Entity& e) {
+    const Mounting& on = e.kind == Mounting::Kind::Joint ? c.joints[e.index].on : c.links[e.index].on;
+    if (on.kind != Mounting::Kind::Chain) return Entity{on.kind, on.index};
+    const int j = e.kind == Mounting::Kind::Joint ? e.index - 1 : m - 1;
+    return j >= 0 ? Entity{Mounting::Kind::Joint, j} : Entity{};
+  };
+  for (int start = 0; start < m + nl; ++start) {
+    const Entity first = start < m ? Entity{Mounting::Kind::Joint, start} : Entity{Mounting::Kind::Link, start - m};
+    std::string chain = name_of(first);
+    Entity e = first;
+    for (int steps = 0; steps <= m + nl; ++steps) {
+      e = parent(e);
+      if (e.kind == Mounting::Kind::Ground) break;
+      chain += " -> " + name_of(e);
+      if (e.kind == first.kind && e.index == first.index) {
+        const ParentRef& pr = first.kind == Mounting::Kind::Joint ? joint_parents[first.index] : link_parents[first.index];
+        r.fail(pr.node, pr.path + ".parent", "the mountings form a cycle (" + chain + ")");
+      }
+    }
+  }
+}
+
+}  // namespace rfem::reading
