@@ -2,6 +2,8 @@
 
 #include <omp.h>
 
+#include <algorithm>
+
 #include "assembly/rfe_kernels.hpp"
 #include "assembly/sde_kernels.hpp"
 
@@ -220,8 +222,14 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
   Workspace& ws = wsp ? *wsp : local;
   const int N = static_cast<int>(model.nodes.size()), m = model.m(), nb = pattern.n_base(),
             ne = static_cast<int>(extra.size()), n6 = model.chain_dofs();
-  values.assign(pattern.nnz(), 0.0);
-  for (const auto& x : extra) x.values->assign(pattern.nnz(), 0.0);
+  // Each chain block's values are zeroed by the chunk that writes them (in cache, on its thread);
+  // the border block here.
+  auto prepare = [&](std::vector<double>& x) {
+    x.resize(pattern.nnz());
+    std::fill(x.begin() + pattern.base(), x.end(), 0.0);
+  };
+  prepare(values);
+  for (const auto& x : extra) prepare(*x.values);
   if (ws.zero.size() != model.dof()) ws.zero = VecX::Zero(model.dof());
   const VecX& zero = ws.zero;
   BaseKinematics& bk = ws.bk;
@@ -241,6 +249,9 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
     unknown[i] = nd.joint >= 0 ? base_col[nd.joint] : nd.coord;
     col[i] = unknown[i] >= 0 ? unknown[i] - n6 : -1;
   }
+  std::vector<int> unknown_ancestors(model.links.size(), 0);  // a chain's border columns that are mass rows
+  for (size_t l = 0; l < model.links.size(); ++l)
+    for (int i : model.links[l].ancestors) unknown_ancestors[l] += col[i] >= 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(model.n()))
   for (int c = 0; c < nchunks; ++c) {
     const Workspace::Chunk ch = ws.chunk[c];
@@ -261,6 +272,12 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
       if (L.carries(k)) continue;  // a node's body; its sdes come after the loop
       const Rfe& rfe = d.rfes[k];
       const int ik = model.rfe_index(ch.link, k), b = ik / Model::rfe_dofs;
+      // D is assigned below, and so is the border wherever it is a mass row: zero E and, for a
+      // chain with a carrying rfe at its end, the border (memory traffic dominates for large n).
+      std::fill_n(values.data() + pattern.coupling(b), 36, 0.0);
+      if (pattern.width(b) > unknown_ancestors[ch.link])
+        std::fill_n(values.data() + pattern.border(b), 6 * pattern.width(b), 0.0);
+      for (const auto& x : extra) std::fill_n(x.values->data() + pattern.diag(b), pattern.block_size(b), 0.0);
       rfe_pose(rfe, fr, q.segment<6>(ik), v.segment<6>(ik), zero.segment<6>(ik), pose, t.inertial, second);
       rfe_mass_blocks(rfe, pose, bk.Xi, anc, Mkk, border, G);
       ws.moments[c].G += G;

@@ -54,6 +54,8 @@ class BorderedPattern {
   long diag(int k) const { return offset_[k]; }
   long coupling(int k) const { return offset_[k] + 36; }
   long border(int k) const { return offset_[k] + 72; }
+  /// Values of block k (D, E and B): slots diag(k) … diag(k) + block_size(k) − 1.
+  long block_size(int k) const { return offset_[k + 1] - offset_[k]; }
   long base() const { return offset_[nblocks_]; }
   /// Index into the value array of entry (r, c), r ≤ c, of the pattern; −1 if (r, c) is outside it.
   long slot(int r, int c) const;

@@ -2,6 +2,11 @@
 // flexible link cut into n rfes: one residual evaluation (generalised forces), one assembly of the
 // Newton matrix, assembly + factorisation (chain solver or CHOLMOD), one solve.
 // Arguments: {n, threads[, solver: 0 chain, 1 CHOLMOD]}.
+// BM_Links*: the cost per rfe of one flexible link of n rfes against two links of n/2 in a row
+// (issue 10 §9): the two-link arm of cases/two_link_arm.toml (shoulder, upper link, elbow on its
+// tip, forearm) and the same 2 m strip as one link of two segments on the shoulder. Arguments
+// {n, links: 1 or 2}; one thread. A step is what an ESDIRK5 step costs: one Newton setup and 12
+// residual evaluations with 12 solves.
 // Pin threads for stable timings: OMP_PROC_BIND=close OMP_PLACES=cores (see bench/README.md).
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -10,6 +15,7 @@
 
 #include "assembly/assemble.hpp"
 #include "cases/case_file.hpp"
+#include "core/rotation.hpp"
 #include "solvers/newton_system.hpp"
 
 using namespace rfem;
@@ -35,6 +41,111 @@ struct Setup {
     for (int j = 0; j < model.m(); ++j) base_col.push_back(model.joint_index(j));  // force input: all joints free
   }
 };
+
+// A random state of small deformation and moving joints.
+void random_state(const Model& model, VecX& q, VecX& v, VecX& a) {
+  std::mt19937 gen(1);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const int N = model.dof();
+  q = v = a = VecX::Zero(N);
+  for (int i = 0; i < N; ++i) {
+    const bool base = i >= model.flexible_dofs();
+    q[i] = (base ? 1.0 : 1e-6) * u(gen);
+    v[i] = (base ? 0.3 : 1e-2) * u(gen);
+    a[i] = u(gen);
+  }
+}
+
+// The two-link arm with n rfes in all, or the same strip as one link (both joints free).
+struct LinksSetup {
+  Model model;
+  VecX q, v, a;
+  std::vector<int> base_col;
+  LinksSetup(int n, int links) {
+    const Case c = read_case(std::string(BENCH_SOURCE_DIR) + "/cases/two_link_arm.toml");
+    if (links == 2) {
+      model = build_model(c, n);
+    } else {
+      MountedLink L;
+      L.name = "strip";
+      FlexibleLink f = c.links[0].link;
+      f.segments.push_back(c.links[1].link.segments[0]);
+      f.segments[0].parts = n / 2;
+      f.segments[1].parts = n - n / 2;
+      L.d = discretise(f);
+      model = make_model({c.joints[0]}, {L}, 0.0);
+    }
+    random_state(model, q, v, a);
+    for (int j = 0; j < model.m(); ++j) base_col.push_back(model.joint_index(j));
+  }
+};
+
+void per_rfe(benchmark::State& state);
+
+void BM_LinksResidual(benchmark::State& state) {
+  omp_set_num_threads(1);
+  LinksSetup s(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  VecX F;
+  Workspace ws;
+  ws.parallel.threads = 1;
+  for (auto _ : state) {
+    generalised_forces(s.model, s.q, s.v, s.a, ForceTerms{}, F, nullptr, &ws);
+    benchmark::DoNotOptimize(F.data());
+  }
+  per_rfe(state);
+}
+
+void BM_LinksStep(benchmark::State& state) {
+  omp_set_num_threads(1);
+  LinksSetup s(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  Workspace ws;
+  ws.parallel.threads = 1;
+  NewtonSystem ns(s.model, s.base_col, LinearSolverKind::Chain, &ws);
+  VecX F, x;
+  if (!ns.setup(s.q, s.v, 0.005)) state.SkipWithError("the Newton matrix is not positive definite");
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ns.setup(s.q, s.v, 0.005));
+    for (int i = 0; i < 12; ++i) {
+      generalised_forces(s.model, s.q, s.v, s.a, ForceTerms{}, F, nullptr, &ws);
+      x = F.head(ns.size());
+      ns.solve(x);
+      benchmark::DoNotOptimize(x.data());
+    }
+  }
+  per_rfe(state);
+}
+
+void BM_LinksSetup(benchmark::State& state) {  // assembly + factorisation of S
+  omp_set_num_threads(1);
+  LinksSetup s(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  Workspace ws;
+  ws.parallel.threads = 1;
+  NewtonSystem ns(s.model, s.base_col, LinearSolverKind::Chain, &ws);
+  for (auto _ : state) benchmark::DoNotOptimize(ns.setup(s.q, s.v, 0.005));
+  per_rfe(state);
+}
+
+void BM_LinksSolve(benchmark::State& state) {
+  omp_set_num_threads(1);
+  LinksSetup s(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  Workspace ws;
+  ws.parallel.threads = 1;
+  NewtonSystem ns(s.model, s.base_col, LinearSolverKind::Chain, &ws);
+  if (!ns.setup(s.q, s.v, 0.005)) state.SkipWithError("the Newton matrix is not positive definite");
+  VecX b = VecX::Ones(ns.size()), x;
+  for (auto _ : state) {
+    x = b;
+    ns.solve(x);
+    benchmark::DoNotOptimize(x.data());
+  }
+  per_rfe(state);
+}
+
+void links_args(benchmark::internal::Benchmark* b) {
+  for (int n : {100, 1000, 10000})
+    for (int l : {1, 2}) b->Args({n, l});
+  b->Unit(benchmark::kMicrosecond)->UseRealTime();
+}
 
 void threads(const benchmark::State& state) { omp_set_num_threads(static_cast<int>(state.range(1))); }
 
@@ -70,7 +181,7 @@ void BM_NewtonSetup(benchmark::State& state) {
 void BM_NewtonAssembly(benchmark::State& state) {  // S alone
   threads(state);
   Setup s(static_cast<int>(state.range(0)));
-  const BorderedPattern p(s.model.n(), s.model.m());
+  const BorderedPattern p(s.model, s.base_col);
   MatrixTerms t;
   t.mass = 1.0;
   t.damping = 0.005;
@@ -118,4 +229,8 @@ BENCHMARK(BM_Residual)->Apply(args);
 BENCHMARK(BM_NewtonAssembly)->Apply(args);
 BENCHMARK(BM_NewtonSetup)->Apply(solver_args);
 BENCHMARK(BM_Solve)->Apply(solver_args);
+BENCHMARK(BM_LinksResidual)->Apply(links_args);
+BENCHMARK(BM_LinksSetup)->Apply(links_args);
+BENCHMARK(BM_LinksSolve)->Apply(links_args);
+BENCHMARK(BM_LinksStep)->Apply(links_args);
 BENCHMARK_MAIN();

@@ -150,6 +150,24 @@ void resolve_mountings(const Reader& r, Case& c, const std::vector<ParentRef>& j
   };
   for (int j = 0; j < m; ++j) c.joints[j].on = mounting(joint_parents[j], true);
   for (int l = 0; l < nl; ++l) c.links[l].on = mounting(link_parents[l], false);
+  // The one link's default: the last joint of the chain from the ground (a joint that sits on the
+  // link, a wrist, comes after it).
+  auto on_a_link = [&](int j) {
+    for (int steps = 0; j >= 0 && steps <= m; ++steps) {
+      const Mounting& on = c.joints[j].on;
+      if (on.kind == Mounting::Kind::Link) return true;
+      j = on.kind == Mounting::Kind::Joint ? on.index : on.kind == Mounting::Kind::Chain ? j - 1 : -1;
+    }
+    return false;
+  };
+  for (int l = 0; l < nl; ++l) {
+    Mounting& on = c.links[l].on;
+    if (on.kind != Mounting::Kind::Chain) continue;
+    int j = m - 1;
+    while (j >= 0 && on_a_link(j)) --j;
+    on.kind = j >= 0 ? Mounting::Kind::Joint : Mounting::Kind::Ground;
+    on.index = j;
+  }
   // No cycles: from every joint and link, the parents lead to the ground.
   auto parent = [&](const Entity& e) {
     const Mounting& on = e.kind == Mounting::Kind::Joint ? c.joints[e.index].on : c.links[e.index].on;

@@ -2,14 +2,15 @@
 
 #include <omp.h>
 
+#include <stdexcept>
+#include <type_traits>
+
 namespace rfem {
 
 namespace {
 using RowMat6 = Eigen::Matrix<double, 6, 6, Eigen::RowMajor>;
 using Block = Eigen::Map<RowMat6>;
 using CBlock = Eigen::Map<const RowMat6>;
-using BorderMap = Eigen::Map<Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>>;
-using CBorderMap = Eigen::Map<const Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>>;
 }  // namespace
 
 ChainSolver::ChainSolver(const BorderedPattern& pattern)
@@ -41,10 +42,49 @@ Mat6 ChainSolver::coupling(const double* v, int prev, int k) const {
   return CBlock(v + pattern_.coupling(prev)).transpose();
 }
 
+namespace {
+// Calls f(std::integral_constant<int, W>) with W = w for 1 ≤ w ≤ 12, else W = Eigen::Dynamic.
+template <class F>
+decltype(auto) with_width(int w, F&& f) {
+  switch (w) {
+#define RFEM_WIDTH(n) \
+  case n:             \
+    return f(std::integral_constant<int, n>{});
+    RFEM_WIDTH(1) RFEM_WIDTH(2) RFEM_WIDTH(3) RFEM_WIDTH(4) RFEM_WIDTH(5) RFEM_WIDTH(6)
+    RFEM_WIDTH(7) RFEM_WIDTH(8) RFEM_WIDTH(9) RFEM_WIDTH(10) RFEM_WIDTH(11) RFEM_WIDTH(12)
+#undef RFEM_WIDTH
+    default:
+      return f(std::integral_constant<int, Eigen::Dynamic>{});
+  }
+}
+// 6 × W row-major (a 6 × 1 border is a column: the same layout, Eigen wants it column-major).
+template <int W>
+using BorderMatrix = Eigen::Matrix<double, 6, W, W == 1 ? Eigen::ColMajor : Eigen::RowMajor>;
+template <int W>
+using BorderW = Eigen::Map<BorderMatrix<W>>;
+template <int W>
+using CBorderW = Eigen::Map<const BorderMatrix<W>>;
+}  // namespace
+
 bool ChainSolver::sweep_factor(double* v, const Sweep& s, MatX& schur) const {
+  const int w = static_cast<int>(pattern_.chains()[s.chain].cols.size());
+  return with_width(w, [&](auto W) { return sweep_factor_w<decltype(W)::value>(v, s, schur); });
+}
+void ChainSolver::sweep_forward(const Sweep& s, VecX& b, VecX& y) const {
+  const int w = static_cast<int>(pattern_.chains()[s.chain].cols.size());
+  with_width(w, [&](auto W) { sweep_forward_w<decltype(W)::value>(s, b, y); });
+}
+void ChainSolver::sweep_backward(const Sweep& s, VecX& b, const VecX& x) const {
+  const int w = static_cast<int>(pattern_.chains()[s.chain].cols.size());
+  with_width(w, [&](auto W) { sweep_backward_w<decltype(W)::value>(s, b, x); });
+}
+
+template <int W>
+bool ChainSolver::sweep_factor_w(double* v, const Sweep& s, MatX& schur) const {
   const int w = static_cast<int>(pattern_.chains()[s.chain].cols.size());
   schur.setZero(6 + w, 6 + w);
   if (s.count == 0) return true;
+  Eigen::Matrix<double, W, W> acc = Eigen::Matrix<double, W, W>::Zero(w, w);  // Σ W_kᵀ W_k
   // In place: D_k ← L_k (lower Cholesky factor), the coupling slot of k ← F_k = L_prev⁻¹ S(prev, k),
   // B_k ← W_k = L_k⁻¹ (B_k − F_kᵀ W_prev).
   int prev = -1;
@@ -52,28 +92,29 @@ bool ChainSolver::sweep_factor(double* v, const Sweep& s, MatX& schur) const {
     const int k = s.first + i * s.step;
     Block D(v + pattern_.diag(k));
     Mat6 Dk = D.selfadjointView<Eigen::Upper>();
-    BorderMap B(v + pattern_.border(k), 6, w);
+    BorderW<W> B(v + pattern_.border(k), 6, w);
     if (prev >= 0) {
       const Mat6 F = CBlock(v + pattern_.diag(prev)).triangularView<Eigen::Lower>().solve(coupling(v, prev, k));
       Block(v + factor_slot(prev, k)) = F;
       Dk.noalias() -= F.transpose() * F;
-      if (w > 0) B.noalias() -= F.transpose() * CBorderMap(v + pattern_.border(prev), 6, w);
+      if (w > 0) B.noalias() -= F.transpose() * CBorderW<W>(v + pattern_.border(prev), 6, w);
     }
     Eigen::LLT<Mat6> llt(Dk);
     if (llt.info() != Eigen::Success) return false;
     D = llt.matrixL().toDenseMatrix();
     if (w > 0) {
-      D.triangularView<Eigen::Lower>().solveInPlace(B);
-      schur.bottomRightCorner(w, w).noalias() += B.transpose() * B;
+      D.template triangularView<Eigen::Lower>().solveInPlace(B);
+      acc.noalias() += B.transpose() * B;
     }
     prev = k;
   }
+  schur.bottomRightCorner(w, w) = acc;
   // The last block's coupling to the separator, eliminated: F_sep = L_last⁻¹ S(last, p).
   const Mat6 Fs = CBlock(v + pattern_.diag(prev)).triangularView<Eigen::Lower>().solve(coupling(v, s.sep, prev).transpose());
   Block(v + factor_slot(prev, s.sep)) = Fs;
   schur.topLeftCorner<6, 6>().noalias() += Fs.transpose() * Fs;
   if (w > 0) {
-    const MatX cross = Fs.transpose() * CBorderMap(v + pattern_.border(prev), 6, w);
+    const Eigen::Matrix<double, 6, W> cross = Fs.transpose() * CBorderW<W>(v + pattern_.border(prev), 6, w);
     schur.topRightCorner(6, w) += cross;
     schur.bottomLeftCorner(w, 6) += cross.transpose();
   }
@@ -96,7 +137,7 @@ bool ChainSolver::factorize(std::vector<double>& values) {
       for (int d = 0; d < nc_; ++d)
         if (d != c) Z.block<6, 6>(6 * c, 6 * d).setZero();
       for (int i = 0; i < nb_; ++i) Z.block<6, 1>(6 * c, off + i).setZero();
-      const CBorderMap B(v + pattern_.border(p), 6, static_cast<long>(cols.size()));
+      const CBorderW<Eigen::Dynamic> B(v + pattern_.border(p), 6, static_cast<long>(cols.size()));
       for (size_t i = 0; i < cols.size(); ++i) Z.block<6, 1>(6 * c, off + cols[i]) = B.col(static_cast<long>(i));
       Z.block(off, 6 * c, nb_, 6) = Z.block(6 * c, off, 6, nb_).transpose();
     }
@@ -121,11 +162,13 @@ bool ChainSolver::factorize(std::vector<double>& values) {
   return true;
 }
 
-void ChainSolver::sweep_forward(const Sweep& s, VecX& b, VecX& y_iface) const {
+template <int W>
+void ChainSolver::sweep_forward_w(const Sweep& s, VecX& b, VecX& y_iface) const {
   const int w = static_cast<int>(pattern_.chains()[s.chain].cols.size());
   y_iface.setZero(6 + w);
   if (s.count == 0) return;
   const double* v = values_;
+  Eigen::Matrix<double, W, 1> y = Eigen::Matrix<double, W, 1>::Zero(w);
   Vec6 prev_y = Vec6::Zero();
   int prev = -1;
   for (int i = 0; i < s.count; ++i) {
@@ -134,24 +177,27 @@ void ChainSolver::sweep_forward(const Sweep& s, VecX& b, VecX& y_iface) const {
     if (prev >= 0) r.noalias() -= CBlock(v + factor_slot(prev, k)).transpose() * prev_y;
     CBlock(v + pattern_.diag(k)).triangularView<Eigen::Lower>().solveInPlace(r);
     b.segment<6>(6 * k) = r;
-    if (w > 0) y_iface.tail(w).noalias() += CBorderMap(v + pattern_.border(k), 6, w).transpose() * r;
+    if (w > 0) y.noalias() += CBorderW<W>(v + pattern_.border(k), 6, w).transpose() * r;
     prev_y = r;
     prev = k;
   }
+  y_iface.tail(w) = y;
   y_iface.head<6>().noalias() += CBlock(v + factor_slot(prev, s.sep)).transpose() * prev_y;
 }
 
-void ChainSolver::sweep_backward(const Sweep& s, VecX& b, const VecX& x_iface) const {
+template <int W>
+void ChainSolver::sweep_backward_w(const Sweep& s, VecX& b, const VecX& x_iface) const {
   if (s.count == 0) return;
   const int w = static_cast<int>(x_iface.size()) - 6;
   const double* v = values_;
+  const Eigen::Matrix<double, W, 1> xb = x_iface.tail(w);
   int next = s.sep;  // the separator's solution is coupled through F_sep
   Vec6 x_next = x_iface.head<6>();
   for (int i = s.count - 1; i >= 0; --i) {
     const int k = s.first + i * s.step;
     Vec6 r = b.segment<6>(6 * k);
     r.noalias() -= CBlock(v + factor_slot(k, next)) * x_next;
-    if (w > 0) r.noalias() -= CBorderMap(v + pattern_.border(k), 6, w) * x_iface.tail(w);
+    if (w > 0) r.noalias() -= CBorderW<W>(v + pattern_.border(k), 6, w) * xb;
     CBlock(v + pattern_.diag(k)).transpose().triangularView<Eigen::Upper>().solveInPlace(r);
     b.segment<6>(6 * k) = r;
     x_next = r;
@@ -162,6 +208,7 @@ void ChainSolver::sweep_backward(const Sweep& s, VecX& b, const VecX& x_iface) c
 void ChainSolver::solve(VecX& b) const {
   const int n6 = 6 * pattern_.n_blocks(), off = 6 * nc_, size = off + nb_;
   if (size == 0) return;
+  if (!values_) throw std::logic_error("ChainSolver::solve without a successful factorisation");
   VecX rhs(size);
   for (int c = 0; c < nc_; ++c) rhs.segment<6>(6 * c) = b.segment<6>(6 * sweeps_[2 * c].sep);
   rhs.tail(nb_) = b.tail(nb_);

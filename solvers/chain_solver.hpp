@@ -40,9 +40,17 @@ class ChainSolver : public LinearSolver {
   // Where the factor's coupling between consecutive blocks a, b of a sweep is kept: the slot of
   // the coupling between them.
   long factor_slot(int a, int b) const { return pattern_.coupling(std::max(a, b)); }
+  // The sweeps, with fixed-size kernels for border widths W = 1 … 12 (Eigen::Dynamic otherwise):
+  // the per-block products are small, and unrolled ones cost a fraction of general ones.
   bool sweep_factor(double* v, const Sweep& s, MatX& schur) const;
   void sweep_forward(const Sweep& s, VecX& b, VecX& y_iface) const;
   void sweep_backward(const Sweep& s, VecX& b, const VecX& x_iface) const;
+  template <int W>
+  bool sweep_factor_w(double* v, const Sweep& s, MatX& schur) const;
+  template <int W>
+  void sweep_forward_w(const Sweep& s, VecX& b, VecX& y_iface) const;
+  template <int W>
+  void sweep_backward_w(const Sweep& s, VecX& b, const VecX& x_iface) const;
   // Interface index of entry i of chain c's Schur contribution (its separator, then its columns).
   int iface_index(int c, int i) const;
   // The chain's part of the interface vector x (separator, then columns).

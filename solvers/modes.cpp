@@ -170,9 +170,9 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
   if (count < 1 || count > N)
     throw std::invalid_argument("mode count must be between 1 and 6n + free joints = " + std::to_string(N));
   ModesResult res;
-  res.q0 = solve_static(model, qb, vb, TipLoads{}).q;
+  res.q0 = solve_static(model, qb, vb, TipLoads{}).q;  // (checks the sizes of qb and vb)
   VecX v = VecX::Zero(model.dof());
-  model.joint_coords(v) = vb;
+  if (vb.size()) model.joint_coords(v) = vb;
   std::vector<int> cols(model.m(), -1);
   for (int i = 0; i < nf; ++i) cols[free[i]] = model.flexible_dofs() + i;
   if (nf > 0) {  // a free joint must be in equilibrium where the held ones are

@@ -73,6 +73,16 @@ class Run:
         self.types = list_attr(group, "joint_types")
         if len(self.types) != ncols:
             self.types = ["revolute"] * ncols
+        # Tip deflections of every link (links/NAME/tip_deflection), or of the one link.
+        self.tips = []
+        names = list_attr(group, "link_names")
+        if len(names) > 1 and "links" in group:
+            for name in names:
+                d = group["links"].get(name)
+                if d is not None and "tip_deflection" in d and d["tip_deflection"].shape[0] == len(self.t):
+                    self.tips.append((name, np.asarray(d["tip_deflection"][:])))
+        elif "tip_deflection" in self.data:
+            self.tips.append(("", self.data["tip_deflection"]))
 
     def col(self, key, j):
         return self.data[key][:, j]
@@ -135,23 +145,25 @@ def plot_run(run, outdir):
         axes[0, 0].set_title(run.title("joint coordinates, rates and torques"))
         fig.tight_layout()
         save(fig, outdir, "%s_joints.png" % g)
-    # Tip deflections.
-    if "tip_deflection" in run.data:
-        td = run.data["tip_deflection"]
-        scale = np.max(np.abs(td[:, :2])) if td.size else 0.0
+    # Tip deflections (of every link: one colour per link).
+    if run.tips:
+        scale = max(np.max(np.abs(td[:, :2])) if td.size else 0.0 for _, td in run.tips)
         fig, axes = plt.subplots(3, 1, sharex=True, figsize=(8, 7))
         for j, (ax, (name, ylabel)) in enumerate(zip(axes, TIP_LABELS)):
-            y = td[:, j]
-            if negligible(y, scale if j < 2 else max(scale, np.max(np.abs(y)) * 1e13)):
-                ax.axhline(0.0, color="C%d" % j, label=name)
-                ax.text(0.5, 0.6, "identically zero" if not np.any(y) else
-                        "round-off only (|%s| ≤ %.1e)" % (name, np.max(np.abs(y))),
-                        transform=ax.transAxes, ha="center", color="0.35")
-            else:
-                ax.plot(run.t, y, label=name, color="C%d" % j)
+            for i, (link, td) in enumerate(run.tips):
+                y = td[:, j]
+                label = "%s %s" % (name, link) if link else name
+                color = "C%d" % (i if len(run.tips) > 1 else j)
+                if negligible(y, scale if j < 2 else max(scale, np.max(np.abs(y)) * 1e13)):
+                    ax.axhline(0.0, color=color, label=label)
+                    ax.text(0.5, 0.6 - 0.15 * i, "%s%s" % (link + ": " if link else "", "identically zero" if not np.any(y) else
+                            "round-off only (|%s| ≤ %.1e)" % (name, np.max(np.abs(y)))),
+                            transform=ax.transAxes, ha="center", color="0.35")
+                else:
+                    ax.plot(run.t, y, label=label, color=color)
             finish(ax, ylabel=ylabel)
         axes[-1].set_xlabel("t [s]")
-        axes[0].set_title(run.title("tip deflections u1, u2 and torsion θ"))
+        axes[0].set_title(run.title("tip deflections u1, u2 and torsion θ" + (" of every link" if len(run.tips) > 1 else "")))
         fig.tight_layout()
         save(fig, outdir, "%s_tip.png" % g)
     # Energy and the drift of the balance.
