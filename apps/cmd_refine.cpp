@@ -151,8 +151,13 @@ bool parse_dynamic(const Case& cs, const std::string& quantity, DynamicQuantity&
   if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: a dynamic quantity needs a [simulation] table");
   const bool known = paper ? (d.run == "rigid" || d.run == "kinematic" || d.run == "force") : d.run == "run";
   if (!known)
-    throw CaseError("--quantity " + quantity + ": no run named '" + d.run + "' (" +
-                    (paper ? "the paper procedure runs rigid, kinematic and force" : "a single run is named run") + ")");
+    throw CaseError("--quantity " + quantity + ": no run or link named '" + d.run + "' (" +
+                    (paper ? "the paper procedure runs rigid, kinematic and force" : "a single run is named run") +
+                    (cs.links.empty() ? std::string() : "; links: " + [&] {
+                      std::string l;
+                      for (const LinkCase& lc : cs.links) l += (l.empty() ? "" : ", ") + lc.name;
+                      return l;
+                    }()) + ")");
   const IntegratorOptions& o = cs.sim.options;
   if (d.time >= 0) {
     const double k = std::round(d.time / o.output_dt);
