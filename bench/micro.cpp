@@ -125,12 +125,9 @@ void BM_LinksSetup(benchmark::State& state) {  // assembly + factorisation of S
   per_rfe(state);
 }
 
-void BM_LinksSolve(benchmark::State& state) {
-  omp_set_num_threads(1);
-  LinksSetup s(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  Workspace ws;
-  ws.parallel.threads = 1;
-  NewtonSystem ns(s.model, s.base_col, LinearSolverKind::Chain, &ws);
+// Newton solves with the system set up at the state (s: Setup or LinksSetup).
+template <class S>
+void solve_loop(benchmark::State& state, const S& s, NewtonSystem& ns) {
   if (!ns.setup(s.q, s.v, 0.005)) state.SkipWithError("the Newton matrix is not positive definite");
   VecX b = VecX::Ones(ns.size()), x;
   for (auto _ : state) {
@@ -139,6 +136,15 @@ void BM_LinksSolve(benchmark::State& state) {
     benchmark::DoNotOptimize(x.data());
   }
   per_rfe(state);
+}
+
+void BM_LinksSolve(benchmark::State& state) {
+  omp_set_num_threads(1);
+  LinksSetup s(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  Workspace ws;
+  ws.parallel.threads = 1;
+  NewtonSystem ns(s.model, s.base_col, LinearSolverKind::Chain, &ws);
+  solve_loop(state, s, ns);
 }
 
 void links_args(benchmark::internal::Benchmark* b) {
@@ -200,14 +206,7 @@ void BM_Solve(benchmark::State& state) {
   threads(state);
   Setup s(static_cast<int>(state.range(0)));
   NewtonSystem ns(s.model, s.base_col, state.range(2) ? LinearSolverKind::Cholmod : LinearSolverKind::Chain);
-  ns.setup(s.q, s.v, 0.005);
-  VecX b = VecX::Ones(ns.size()), x;
-  for (auto _ : state) {
-    x = b;
-    ns.solve(x);
-    benchmark::DoNotOptimize(x.data());
-  }
-  per_rfe(state);
+  solve_loop(state, s, ns);
 }
 
 void args(benchmark::internal::Benchmark* b) {

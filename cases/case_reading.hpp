@@ -174,6 +174,8 @@ using Sections = std::map<std::string, Section>;
 
 /// A constant transform {xyz, rpy} (translation, then roll–pitch–yaw angles).
 Mat4 transform(const Reader& r, const toml::table& t, const std::string& path);
+/// The `mount` key of a joint or link (identity if absent).
+Mat4 read_mount(const Reader& r, const toml::table& t, const std::string& path);
 /// The named tables [materials.*] and [sections.*].
 Materials read_materials(const Reader& r, const toml::table& root);
 Sections read_sections(const Reader& r, const toml::table& root);

@@ -11,6 +11,13 @@ Mat4 transform(const Reader& r, const toml::table& t, const std::string& path) {
   return homogeneous(rot_rpy(r.vec3(t, path, "rpy", Vec3::Zero())), r.vec3(t, path, "xyz", Vec3::Zero()));
 }
 
+Mat4 read_mount(const Reader& r, const toml::table& t, const std::string& path) {
+  const toml::node* mn = t.get("mount");
+  if (!mn) return Mat4::Identity();
+  if (!mn->is_table()) r.fail(mn, path + ".mount", "must be a table {xyz, rpy}");
+  return transform(r, *mn->as_table(), path + ".mount");
+}
+
 namespace {
 
 Material read_material(const Reader& r, const toml::table& t, const std::string& path, const std::string& name) {

@@ -115,10 +115,7 @@ void read_joints(const Reader& r, const toml::table& root, const Materials& mats
     pr.node = jt.get("parent") ? jt.get("parent") : &jt;
     pr.name = r.string(jt, p, "parent", std::string());
     pr.at = jt.get("at");
-    if (const toml::node* mn = jt.get("mount")) {
-      if (!mn->is_table()) r.fail(mn, p + ".mount", "must be a table {xyz, rpy}");
-      pr.X = transform(r, *mn->as_table(), p + ".mount");
-    }
+    pr.X = read_mount(r, jt, p);
     parents.push_back(pr);
     c.inputs.push_back(in);
     c.joints.push_back(j);

@@ -20,10 +20,7 @@ LinkCase read_link(const Reader& r, const toml::table& lt, const std::string& ke
   parent.node = lt.get("parent") ? lt.get("parent") : &lt;
   parent.name = r.string(lt, key, "parent", std::string());
   parent.at = lt.get("at");
-  if (const toml::node* mn = lt.get("mount")) {
-    if (!mn->is_table()) r.fail(mn, key + ".mount", "must be a table {xyz, rpy}");
-    parent.X = transform(r, *mn->as_table(), key + ".mount");
-  }
+  parent.X = read_mount(r, lt, key);
   const toml::node* sn = lt.get("segments");
   if (!sn) r.fail(&lt, key + ".segments", "missing: a link needs at least one segment");
   auto arr = sn->as_array();

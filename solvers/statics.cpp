@@ -73,9 +73,10 @@ int loaded_link(const Model& model, const TipLoads& loads) {
 }
 
 VecX tip_load_forces(const Model& model, const VecX& q, const TipLoads& loads) {
+  VecX Q = VecX::Zero(model.dof());
+  if (loads.force.isZero(0.0) && loads.moment.isZero(0.0)) return Q;
   const int l = loaded_link(model, loads);
   const MountedLink& L = model.links[l];
-  VecX Q = VecX::Zero(model.dof());
   BaseKinematics bk, ref;
   const VecX z = VecX::Zero(model.dof());
   base_kinematics(model, q, z, z, bk);

@@ -114,6 +114,34 @@ void expect_inertial_force_satisfies_lagrange(const Model& m, const VecX& q, con
   EXPECT_LT(rel(eps, dpdt - dTdq), 1e-6);
 }
 
+// Elastic and gravity forces are the gradients of their energies.
+void expect_forces_are_gradients_of_energies(const Model& m, const VecX& q) {
+  const VecX zero = VecX::Zero(m.dof());
+  VecX fe, fg;
+  generalised_forces(m, q, zero, zero, only(false, false, true), fe);
+  generalised_forces(m, q, zero, zero, only(false, true, false), fg);
+  EXPECT_LT(rel(fe, fd_gradient([&](const VecX& x) { return energies(m, x, zero).elastic; }, q)), 1e-6);
+  EXPECT_LT(rel(fg, fd_gradient([&](const VecX& x) { return energies(m, x, zero).gravity; }, q)), 1e-6);
+}
+
+// K (sparse and dense, with the geometric and gravity terms) against the Jacobian of the elastic
+// and gravity forces.
+void expect_stiffness_is_jacobian_of_forces(const Model& m, const VecX& q) {
+  const VecX zero = VecX::Zero(m.dof());
+  MatrixTerms t;
+  t.stiffness = 1.0;
+  t.gravity = true;
+  const MatX Kfd = fd_jacobian(
+      [&](const VecX& x) {
+        VecX f;
+        generalised_forces(m, x, zero, zero, only(false, true, true), f);
+        return f;
+      },
+      q);
+  EXPECT_LT(rel(assembled(m, q, zero, t), Kfd), 1e-6);
+  EXPECT_LT(rel(dense_stiffness(m, q, true), Kfd), 1e-6);
+}
+
 }  // namespace
 
 TEST(KernelsFD, MassMatrixIsHessianOfKineticEnergy) {
@@ -148,32 +176,14 @@ TEST(KernelsFD, ForcesAreGradientsOfEnergies) {
   const Model m = test::spatial_arm(5);
   VecX q, v, a;
   test::random_state(m, 3, q, v, a);
-  const VecX zero = VecX::Zero(m.dof());
-  VecX fe, fg;
-  generalised_forces(m, q, zero, zero, only(false, false, true), fe);
-  generalised_forces(m, q, zero, zero, only(false, true, false), fg);
-  EXPECT_LT(rel(fe, fd_gradient([&](const VecX& x) { return energies(m, x, zero).elastic; }, q)), 1e-6);
-  EXPECT_LT(rel(fg, fd_gradient([&](const VecX& x) { return energies(m, x, zero).gravity; }, q)), 1e-6);
+  expect_forces_are_gradients_of_energies(m, q);
 }
 
 TEST(KernelsFD, StiffnessIsJacobianOfElasticAndGravityForces) {
   const Model m = test::spatial_arm(4);
   VecX q, v, a;
   test::random_state(m, 4, q, v, a);
-  const VecX zero = VecX::Zero(m.dof());
-  MatrixTerms t;
-  t.stiffness = 1.0;
-  t.gravity = true;
-  const MatX K = assembled(m, q, zero, t);
-  const MatX Kfd = fd_jacobian(
-      [&](const VecX& x) {
-        VecX f;
-        generalised_forces(m, x, zero, zero, only(false, true, true), f);
-        return f;
-      },
-      q);
-  EXPECT_LT(rel(K, Kfd), 1e-6);
-  EXPECT_LT(rel(dense_stiffness(m, q, true), Kfd), 1e-6);
+  expect_stiffness_is_jacobian_of_forces(m, q);
 }
 
 TEST(KernelsFD, DampingMatrixIsJacobianOfDampingForces) {
@@ -253,15 +263,15 @@ TEST(KernelsFD, TipForceDoesVirtualWork) {
   TipLoads loads;
   loads.force = Vec3(1.0, -2.0, 3.0);
   const int n = m.n();
-  const Vec6 Q = tip_generalised_force(m, 0, q.segment<6>(6 * (n - 1)), loads);
+  const Vec6 Q = tip_generalised_force(m, 0, q.segment<6>(m.rfe_index(0, n - 1)), loads);
   // Q_j = F · ∂p_tip/∂q_j
   const VecX g = fd_gradient(
       [&](const VecX& x) {
         VecX qq = q;
-        qq.segment<6>(6 * (n - 1)) = x;
+        qq.segment<6>(m.rfe_index(0, n - 1)) = x;
         return loads.force.dot(tip_motion(m, 0, qq).head<3>());
       },
-      VecX(q.segment<6>(6 * (n - 1))));
+      VecX(q.segment<6>(m.rfe_index(0, n - 1))));
   EXPECT_LT((Q - g).norm(), 1e-8 * Q.norm());
 }
 
@@ -278,22 +288,6 @@ TEST(KernelsFD, TreeOfLinksJointsAndPayloadsIsConsistent) {
   EXPECT_GT(es.eigenvalues().minCoeff(), 0.0) << "M must be positive definite";
   expect_inertial_force_satisfies_lagrange(m, q, v, a);
   expect_damping_is_jacobian_of_dissipative_forces(m, q, v);
-  const VecX zero = VecX::Zero(m.dof());
-  VecX fe, fg;
-  generalised_forces(m, q, zero, zero, only(false, false, true), fe);
-  generalised_forces(m, q, zero, zero, only(false, true, false), fg);
-  EXPECT_LT(rel(fe, fd_gradient([&](const VecX& x) { return energies(m, x, zero).elastic; }, q)), 1e-6);
-  EXPECT_LT(rel(fg, fd_gradient([&](const VecX& x) { return energies(m, x, zero).gravity; }, q)), 1e-6);
-  MatrixTerms t;
-  t.stiffness = 1.0;
-  t.gravity = true;
-  const MatX Kfd = fd_jacobian(
-      [&](const VecX& x) {
-        VecX f;
-        generalised_forces(m, x, zero, zero, only(false, true, true), f);
-        return f;
-      },
-      q);
-  EXPECT_LT(rel(assembled(m, q, zero, t), Kfd), 1e-6);
-  EXPECT_LT(rel(dense_stiffness(m, q, true), Kfd), 1e-6);
+  expect_forces_are_gradients_of_energies(m, q);
+  expect_stiffness_is_jacobian_of_forces(m, q);
 }

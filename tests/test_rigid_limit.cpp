@@ -60,7 +60,7 @@ TEST(RigidLimit, UndeformedFlexibleLinkActsAsRigidBody) {
   const Model rigid = rigidify(flex);  // every rfe's pseudo-inertia moved into the last link
   VecX q, v, a;
   test::random_state(flex, 21, q, v, a);
-  const int Nf = 6 * flex.n();
+  const int Nf = flex.flexible_dofs();
   q.head(Nf).setZero();
   v.head(Nf).setZero();
   a.head(Nf).setZero();
