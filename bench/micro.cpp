@@ -11,6 +11,7 @@
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
+#include <memory>
 #include <random>
 
 #include "assembly/assemble.hpp"
@@ -22,48 +23,44 @@ using namespace rfem;
 
 namespace {
 
-struct Setup {
-  Model model;
-  VecX q, v, a;
-  std::vector<int> base_col;
-  explicit Setup(int n)
-      : model(build_model(read_case(std::string(BENCH_SOURCE_DIR) + "/cases/paper_deployment.toml"), n)) {
-    std::mt19937 gen(1);
-    std::uniform_real_distribution<double> u(-1, 1);
-    const int N = model.dof();
-    q = v = a = VecX::Zero(N);
-    for (int i = 0; i < N; ++i) {
-      const bool base = i >= model.flexible_dofs();
-      q[i] = (base ? 1.0 : 1e-3) * u(gen);
-      v[i] = (base ? 0.3 : 1e-2) * u(gen);
-      a[i] = u(gen);
-    }
-    for (int j = 0; j < model.m(); ++j) base_col.push_back(model.joint_index(j));  // force input: all joints free
-  }
-};
-
-// A random state of small deformation and moving joints.
-void random_state(const Model& model, VecX& q, VecX& v, VecX& a) {
+// A random state: deformation of scale `flex` [m, rad], moving joints.
+void random_state(const Model& model, double flex, VecX& q, VecX& v, VecX& a) {
   std::mt19937 gen(1);
   std::uniform_real_distribution<double> u(-1, 1);
   const int N = model.dof();
   q = v = a = VecX::Zero(N);
   for (int i = 0; i < N; ++i) {
     const bool base = i >= model.flexible_dofs();
-    q[i] = (base ? 1.0 : 1e-6) * u(gen);
+    q[i] = (base ? 1.0 : flex) * u(gen);
     v[i] = (base ? 0.3 : 1e-2) * u(gen);
     a[i] = u(gen);
   }
 }
 
-// The two-link arm with n rfes in all, or the same strip as one link (both joints free).
+struct Setup {
+  Model model;
+  VecX q, v, a;
+  std::vector<int> base_col;
+  explicit Setup(int n)
+      : model(build_model(read_case(std::string(BENCH_SOURCE_DIR) + "/cases/paper_deployment.toml"), n)) {
+    random_state(model, 1e-3, q, v, a);
+    for (int j = 0; j < model.m(); ++j) base_col.push_back(model.joint_index(j));  // force input: all joints free
+  }
+};
+
+// The two-link arm with n rfes in all, or the same strip as one link (both joints free), with a
+// one-thread workspace and its Newton system.
 struct LinksSetup {
   Model model;
   VecX q, v, a;
   std::vector<int> base_col;
-  LinksSetup(int n, int links) {
+  Workspace ws;
+  std::unique_ptr<NewtonSystem> ns;
+  explicit LinksSetup(const benchmark::State& state) {
+    omp_set_num_threads(1);
+    const int n = static_cast<int>(state.range(0));
     const Case c = read_case(std::string(BENCH_SOURCE_DIR) + "/cases/two_link_arm.toml");
-    if (links == 2) {
+    if (state.range(1) == 2) {
       model = build_model(c, n);
     } else {
       MountedLink L;
@@ -75,55 +72,14 @@ struct LinksSetup {
       L.d = discretise(f);
       model = make_model({c.joints[0]}, {L}, 0.0);
     }
-    random_state(model, q, v, a);
+    random_state(model, 1e-6, q, v, a);  // (a light strip: small deformation keeps S positive definite)
     for (int j = 0; j < model.m(); ++j) base_col.push_back(model.joint_index(j));
+    ws.parallel.threads = 1;
+    ns = std::make_unique<NewtonSystem>(model, base_col, LinearSolverKind::Chain, &ws);
   }
 };
 
 void per_rfe(benchmark::State& state);
-
-void BM_LinksResidual(benchmark::State& state) {
-  omp_set_num_threads(1);
-  LinksSetup s(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  VecX F;
-  Workspace ws;
-  ws.parallel.threads = 1;
-  for (auto _ : state) {
-    generalised_forces(s.model, s.q, s.v, s.a, ForceTerms{}, F, nullptr, &ws);
-    benchmark::DoNotOptimize(F.data());
-  }
-  per_rfe(state);
-}
-
-void BM_LinksStep(benchmark::State& state) {
-  omp_set_num_threads(1);
-  LinksSetup s(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  Workspace ws;
-  ws.parallel.threads = 1;
-  NewtonSystem ns(s.model, s.base_col, LinearSolverKind::Chain, &ws);
-  VecX F, x;
-  if (!ns.setup(s.q, s.v, 0.005)) state.SkipWithError("the Newton matrix is not positive definite");
-  for (auto _ : state) {
-    benchmark::DoNotOptimize(ns.setup(s.q, s.v, 0.005));
-    for (int i = 0; i < 12; ++i) {
-      generalised_forces(s.model, s.q, s.v, s.a, ForceTerms{}, F, nullptr, &ws);
-      x = F.head(ns.size());
-      ns.solve(x);
-      benchmark::DoNotOptimize(x.data());
-    }
-  }
-  per_rfe(state);
-}
-
-void BM_LinksSetup(benchmark::State& state) {  // assembly + factorisation of S
-  omp_set_num_threads(1);
-  LinksSetup s(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  Workspace ws;
-  ws.parallel.threads = 1;
-  NewtonSystem ns(s.model, s.base_col, LinearSolverKind::Chain, &ws);
-  for (auto _ : state) benchmark::DoNotOptimize(ns.setup(s.q, s.v, 0.005));
-  per_rfe(state);
-}
 
 // Newton solves with the system set up at the state (s: Setup or LinksSetup).
 template <class S>
@@ -138,13 +94,41 @@ void solve_loop(benchmark::State& state, const S& s, NewtonSystem& ns) {
   per_rfe(state);
 }
 
+void BM_LinksResidual(benchmark::State& state) {
+  LinksSetup s(state);
+  VecX F;
+  for (auto _ : state) {
+    generalised_forces(s.model, s.q, s.v, s.a, ForceTerms{}, F, nullptr, &s.ws);
+    benchmark::DoNotOptimize(F.data());
+  }
+  per_rfe(state);
+}
+
+void BM_LinksStep(benchmark::State& state) {
+  LinksSetup s(state);
+  VecX F, x;
+  if (!s.ns->setup(s.q, s.v, 0.005)) state.SkipWithError("the Newton matrix is not positive definite");
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(s.ns->setup(s.q, s.v, 0.005));
+    for (int i = 0; i < 12; ++i) {
+      generalised_forces(s.model, s.q, s.v, s.a, ForceTerms{}, F, nullptr, &s.ws);
+      x = F.head(s.ns->size());
+      s.ns->solve(x);
+      benchmark::DoNotOptimize(x.data());
+    }
+  }
+  per_rfe(state);
+}
+
+void BM_LinksSetup(benchmark::State& state) {  // assembly + factorisation of S
+  LinksSetup s(state);
+  for (auto _ : state) benchmark::DoNotOptimize(s.ns->setup(s.q, s.v, 0.005));
+  per_rfe(state);
+}
+
 void BM_LinksSolve(benchmark::State& state) {
-  omp_set_num_threads(1);
-  LinksSetup s(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  Workspace ws;
-  ws.parallel.threads = 1;
-  NewtonSystem ns(s.model, s.base_col, LinearSolverKind::Chain, &ws);
-  solve_loop(state, s, ns);
+  LinksSetup s(state);
+  solve_loop(state, s, *s.ns);
 }
 
 void links_args(benchmark::internal::Benchmark* b) {
