@@ -5,12 +5,6 @@
 
 namespace rfem {
 
-int Model::link_named(const std::string& name) const {
-  for (size_t l = 0; l < links.size(); ++l)
-    if (links[l].name == name) return static_cast<int>(l);
-  return -1;
-}
-
 namespace {
 
 Mat4 translation(const Vec3& t) { return homogeneous(Mat3::Identity(), t); }

@@ -84,8 +84,6 @@ struct Model {
     const auto d = nodes[a].path.size();
     return d <= p.size() && p[d - 1] == a;
   }
-  /// Index of the link with this name, −1 if none.
-  int link_named(const std::string& name) const;
 };
 
 /// Builds a model: places every joint and link on what it is mounted on (throws
