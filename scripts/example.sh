@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the dependencies (Debian 12, root), builds rfem and runs the main examples:
-# Kane's beam modes and refinement, the paper's link 3 modes, and a static tip load.
+# the paper's deployment and its figures, the two-link flexible arm, Kane's beam modes and
+# refinement, the paper's link 3 modes, and a static tip load.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -9,6 +10,8 @@ cmake --build build -j "$(nproc)"
 set -x
 build/apps/rfem run cases/paper_deployment.toml -o paper_deployment.h5
 build/apps/rfem plot paper_deployment.h5 -o figures
+build/apps/rfem run cases/two_link_arm.toml -o two_link_arm.h5
+build/apps/rfem plot two_link_arm.h5 -o figures
 build/apps/rfem modes cases/kane_beam.toml --count 8
 build/apps/rfem refine cases/kane_beam.toml --n 5,10,20,40,80 --quantity bending-y:1
 build/apps/rfem static cases/kane_beam.toml
