@@ -26,9 +26,7 @@ std::string split_prefixes(const Case& cs, const std::string& quantity, std::str
   for (auto slash = q.find('/'); slash != std::string::npos; slash = q.find('/')) {
     const std::string p = q.substr(0, slash);
     q = q.substr(slash + 1);
-    int l = -1;
-    for (size_t i = 0; i < cs.links.size(); ++i)
-      if (cs.links[i].name == p) l = static_cast<int>(i);
+    const int l = cs.link_index(p);
     if (l >= 0 && link < 0) link = l;
     else if (l < 0 && run.empty() && link < 0) run = p;
     else throw CaseError("--quantity " + quantity + ": expected [RUN/][LINK/]QUANTITY ('" + p + "' is not where a run or link goes)");

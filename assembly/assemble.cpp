@@ -27,12 +27,6 @@ int Workspace::chunks(const Model& model) {
   return c;
 }
 
-bool sdes_damped(const Model& model) {
-  for (const MountedLink& L : model.links)
-    if (L.d.damping_beta != 0.0) return true;
-  return false;
-}
-
 namespace {
 
 // rfe_0's rotation (zero coordinates): R = I, ∂R/∂φ the generators.

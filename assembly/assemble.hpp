@@ -69,8 +69,6 @@ inline Vec6 rfe_coords(const Model& model, const VecX& x, int l, int k) { return
 inline Vec6 left_coords(const Model& model, const VecX& x, int l, int e) {
   return e > 0 ? rfe_coords(model, x, l, e - 1) : Vec6::Zero().eval();
 }
-/// Whether any link's sdes are damped.
-bool sdes_damped(const Model& model);
 /// The base part of a full coordinate vector.
 inline VecX base_coords(const Model& model, const VecX& x) { return model.joint_coords(x); }
 

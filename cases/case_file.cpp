@@ -175,8 +175,7 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
     c.loads.moment = r.vec3(lt, "loads", "tip_moment", Vec3::Zero());
     if (lt.get("link")) {
       const std::string name = r.string(lt, "loads", "link");
-      for (size_t l = 0; l < c.links.size(); ++l)
-        if (c.links[l].name == name) c.loads.link = static_cast<int>(l);
+      c.loads.link = c.link_index(name);
       if (c.loads.link < 0) r.fail(lt.get("link"), "loads.link", "no link named '" + name + "'");
     }
   }

@@ -61,6 +61,12 @@ struct Case {
   std::string name, description;
   std::vector<LinkCase> links;     ///< [link] or [[links]]
   bool has_link() const { return !links.empty(); }
+  /// Index of the link named `name`, −1 if none.
+  int link_index(const std::string& name) const {
+    for (size_t l = 0; l < links.size(); ++l)
+      if (links[l].name == name) return static_cast<int>(l);
+    return -1;
+  }
   std::vector<Joint> joints;       ///< a free base's six joints first, then [[joints]] (mountings resolved)
   bool free_base = false;          ///< [base] kind = "free"
   VecX joint_values, joint_rates;  ///< initial/held values and steady rates

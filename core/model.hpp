@@ -78,6 +78,12 @@ struct Model {
   /// The joints' part of a full coordinate vector (rates, accelerations, forces alike).
   Eigen::VectorBlock<VecX> joint_coords(VecX& x) const { return x.segment(flexible_dofs(), m()); }
   Eigen::VectorBlock<const VecX> joint_coords(const VecX& x) const { return x.segment(flexible_dofs(), m()); }
+  /// Whether any link's sdes are damped.
+  bool sdes_damped() const {
+    for (const MountedLink& L : links)
+      if (L.d.damping_beta != 0.0) return true;
+    return false;
+  }
   /// Whether node a is node b or one of its ancestors (a ≤ b in the tree).
   bool ancestor(int a, int b) const {
     const auto& p = nodes[b].path;

@@ -23,7 +23,7 @@ EquationsOfMotion::EquationsOfMotion(const Model& model, const std::vector<Joint
       terms_(terms),
       governor_(model.n() >= parallel.min_rfes ? (parallel.threads > 0 ? parallel.threads : omp_get_max_threads()) : 1,
                 parallel.threads > 0),
-      damped_(sdes_damped(model) ||
+      damped_(model.sdes_damped() ||
               std::any_of(model.joints.begin(), model.joints.end(),
                           [](const Joint& j) { return j.drive.damping > 0 || j.drive.friction > 0; })) {
   ws_.parallel = parallel;
@@ -106,7 +106,7 @@ Power EquationsOfMotion::power_change(double t, const double* vu, const VecX& da
       d.input += law.at(t, q_[model_.joint_index(j)], vj) * dv - (law.stiffness() * dq + law.damping() * dv) * vj;
     }
   }
-  if (sdes_damped(model_)) {  // the Newton system keeps the sdes' C only then
+  if (model_.sdes_damped()) {  // the Newton system keeps the sdes' C only then
     VecX Cda;
     newton_->damping_times(da, Cda);
     d.dissipation = 2.0 * hg * Eigen::Map<const VecX>(vu, unknowns()).dot(Cda);

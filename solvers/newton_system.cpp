@@ -11,7 +11,7 @@ NewtonSystem::NewtonSystem(const Model& model, std::vector<int> base_col, Linear
       base_col_(std::move(base_col)),
       pattern_(model, base_col_),
       solver_(make_linear_solver(kind, pattern_)),
-      damped_(sdes_damped(model)),
+      damped_(model.sdes_damped()),
       keep_stiffness_(keep_stiffness) {}
 
 bool NewtonSystem::setup(const VecX& q, const VecX& v, double h) {

@@ -37,21 +37,26 @@ Vec6 tip_motion(const Model& model, int l, const VecX& q) {
   return out;
 }
 
-Vec3 point_position(const Model& model, int l, double s, const VecX& q) {
+namespace {
+// The point at s on link l's elastic axis, in {r}: moving with the rfe whose span holds it.
+Vec3 point_in_r(const Model& model, int l, double s, const VecX& q) {
   const MountedLink& L = model.links[l];
+  const int k = rfe_at(L.d, s);
+  if (k < 0) return Vec3(s, 0.0, 0.0);  // rigid with {r}
+  const Vec6 qk = q.segment<6>(model.rfe_index(l, k));
+  DeformationTransform d;
+  deformation_transform(qk, d, false);
+  const Vec3 eta = Vec3(s, 0.0, 0.0) - L.d.rfes[k].centre;  // in the rfe's frame
+  return L.d.rfes[k].centre + qk.head<3>() + d.D.topLeftCorner<3, 3>() * eta;
+}
+}  // namespace
+
+Vec3 point_position(const Model& model, int l, double s, const VecX& q) {
   BaseKinematics bk;
   const VecX z = VecX::Zero(model.dof());
   base_kinematics(model, q, z, z, bk);
-  Vec3 local(s, 0.0, 0.0);  // rigid with {r}
-  if (const int k = rfe_at(L.d, s); k >= 0) {
-    const Vec6 qk = q.segment<6>(model.rfe_index(l, k));
-    DeformationTransform d;
-    deformation_transform(qk, d, false);
-    const Vec3 eta = Vec3(s, 0.0, 0.0) - L.d.rfes[k].centre;  // in the rfe's frame
-    local = L.d.rfes[k].centre + qk.head<3>() + d.D.topLeftCorner<3, 3>() * eta;
-  }
   const Mat4& B0 = bk.frame[l].B0;
-  return B0.topLeftCorner<3, 3>() * local + B0.topRightCorner<3, 1>();
+  return B0.topLeftCorner<3, 3>() * point_in_r(model, l, s, q) + B0.topRightCorner<3, 1>();
 }
 
 Vec3 tip_position(const Model& model, int l, const VecX& q) { return point_position(model, l, model.links[l].d.length, q); }
@@ -85,20 +90,16 @@ VecX tip_load_forces(const Model& model, const VecX& q, const TipLoads& loads) {
   base_kinematics(model, q0, z, z, ref);
   const Mat3 R0 = bk.frame[l].B0.topLeftCorner<3, 3>(), Rref = ref.frame[l].B0.topLeftCorner<3, 3>();
   const Vec3 F = Rref * loads.force, M = Rref * loads.moment;  // in {0}
-  Vec3 local(L.d.length, 0.0, 0.0);  // the tip in {r}
   if (L.n() > 0) {
     const int at = model.rfe_index(l, L.n() - 1);
-    const Vec6 qn = q.segment<6>(at);
     TipLoads own = loads;  // in the axes of {r} now (the same when {r} has not moved)
     if (R0 != Rref) {
       own.force = R0.transpose() * F;
       own.moment = R0.transpose() * M;
     }
-    Q.segment<6>(at) = tip_generalised_force(model, l, qn, own);
-    DeformationTransform d;
-    deformation_transform(qn, d, false);
-    local = L.d.rfes.back().centre + qn.head<3>() + d.D.topLeftCorner<3, 3>() * L.d.tip_eta;
+    Q.segment<6>(at) = tip_generalised_force(model, l, q.segment<6>(at), own);
   }
+  const Vec3 local = point_in_r(model, l, L.d.length, q);  // the tip in {r}
   const Mat4& B0 = bk.frame[l].B0;
   const Vec4 p = B0 * Vec4(local[0], local[1], local[2], 1.0);
   for (int j : L.ancestors) {  // ∂p/∂q_j = (Ξ_j p)₁₋₃, ω_j = vee of Ξ_j's rotation
