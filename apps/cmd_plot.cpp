@@ -1,17 +1,29 @@
+// `rfem plot` hands the file to rfem_plot.py (matplotlib + h5py from Debian's packages, run by
+// /usr/bin/python3: the python3 first on PATH may not see them). The script is found beside the
+// program: ../share/rfem/ from its directory, installed (bin/) and in the build tree (apps/).
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
 
-#include "apps/commands.hpp"
+#include "commands.hpp"
 
 namespace rfem::app {
 
-// `rfem plot` hands the file to tools/rfem_plot.py (matplotlib + h5py from Debian's packages, run
-// by /usr/bin/python3: the python3 first on PATH may not see them).
+namespace {
+std::string plot_script() {
+  if (const char* env = std::getenv("RFEM_PLOT_SCRIPT")) return env;
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) throw std::runtime_error("cannot locate the rfem program to find its plot script: " + ec.message());
+  return (exe.parent_path().parent_path() / "share" / "rfem" / "rfem_plot.py").string();
+}
+}  // namespace
+
 int run_plot(const std::string& results, const std::string& outdir) {
-  std::string script = std::string(RFEM_SOURCE_DIR) + "/tools/rfem_plot.py";
-  if (!std::filesystem::exists(script)) throw std::runtime_error("plot script not found: " + script);
+  const std::string script = plot_script();
+  if (!std::filesystem::exists(script))
+    throw std::runtime_error("plot script not found: " + script + " (set RFEM_PLOT_SCRIPT to tools/rfem_plot.py)");
   const char* python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   std::vector<std::string> args{python, script, results};
   if (!outdir.empty()) args.insert(args.end(), {"-o", outdir});

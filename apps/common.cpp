@@ -1,27 +1,37 @@
 // Helpers shared by the commands.
 #include <fmt/core.h>
 
-#include "apps/commands.hpp"
+#include "commands.hpp"
+#include "rfem/assembly/workspace.hpp"
+#include "rfem/studies/estimate.hpp"
 
 namespace rfem::app {
 
 void print_json(const nlohmann::json& j) { fmt::print("{}\n", j.dump(2)); }
 
+void print_warning(const std::string& w) { fmt::print(stderr, "rfem: warning: {}\n", w); }
+
 Case read_checked_case(const Common& c) {
   Case cs = read_case(c.case_path, c.overrides);
-  for (const auto& w : cs.warnings) fmt::print(stderr, "rfem: warning: {}\n", w);
+  for (const auto& w : cs.warnings) print_warning(w);
   return cs;
 }
 
-void joint_state(const Case& cs, const ModesOptions& o, VecX& qb, VecX& vb) {
-  qb = cs.joint_values;
-  vb = cs.joint_rates;
-  if (o.rate_given) {
-    if (o.joint < 1 || o.joint > static_cast<int>(cs.joints.size()))
-      throw CaseError(cs.path + ": --joint " + std::to_string(o.joint) + ": the case has " +
-                      std::to_string(cs.joints.size()) + " joints");
-    vb[o.joint - 1] = o.rate;
-  }
+void check_run_cost(const Case& cs, std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs, const Common& c) {
+  const bool note = model->n() >= kLargeRunRfes && !(c.json || c.quiet);
+  const RunEstimate e = check_affordable(cs, model, inputs, c.threads, note);
+  if (note)
+    fmt::print(stderr,
+               "rfem: note: n = {} rfes: about {:.0f} MB of memory; one residual evaluation {:.3g} ms, one Newton "
+               "matrix {:.3g} ms, so about {:.2g} s per step (the shipped cases take 400 to 6000 steps at the "
+               "default tolerances)\n",
+               model->n(), e.bytes / 1e6, e.residual_s * 1e3, e.newton_setup_s * 1e3, e.step_s());
+}
+
+int max_threads(const Common& c) {
+  Parallelism p;
+  p.threads = c.threads;
+  return p.max_threads();
 }
 
 }  // namespace rfem::app

@@ -1,4 +1,4 @@
-#include "apps/progress.hpp"
+#include "progress.hpp"
 
 #include <fmt/core.h>
 #include <unistd.h>
@@ -7,25 +7,29 @@
 
 namespace rfem::app {
 
-Progress::Progress(std::string label, double t_end, bool quiet)
-    : label_(std::move(label)), t_end_(t_end), active_(!quiet && isatty(fileno(stderr))),
-      start_(std::chrono::steady_clock::now()), last_(start_) {}
+ProgressLine::ProgressLine(bool quiet)
+    : active_(!quiet && isatty(fileno(stderr))), start_(std::chrono::steady_clock::now()), last_(start_) {}
 
-void Progress::update(double t, long steps) {
+void ProgressLine::show(const Progress& p) {
   if (!active_) return;
   const auto now = std::chrono::steady_clock::now();
-  if (now - last_ < std::chrono::milliseconds(200)) return;
+  if (p.run != run_) {
+    run_ = p.run;
+    start_ = now;
+  } else if (now - last_ < std::chrono::milliseconds(200)) {
+    return;
+  }
   last_ = now;
   const double wall = std::chrono::duration<double>(now - start_).count();
-  const double frac = t_end_ > 0 ? t / t_end_ : 1.0;
+  const double frac = p.t_end > 0 ? p.t / p.t_end : 1.0;
   const double left = frac > 0 ? wall * (1.0 - frac) / frac : 0.0;
-  fmt::print(stderr, "\r{:<10} t = {:.3f} / {:.3f} s ({:5.1f} %), {:.0f} steps/s, {:.1f} s left   ", label_, t,
-             t_end_, 100.0 * frac, wall > 0 ? steps / wall : 0.0, left);
+  fmt::print(stderr, "\r{:<10} t = {:.3f} / {:.3f} s ({:5.1f} %), {:.0f} steps/s, {:.1f} s left   ", p.run, p.t, p.t_end,
+             100.0 * frac, wall > 0 ? p.steps / wall : 0.0, left);
   std::fflush(stderr);
   drawn_ = true;
 }
 
-void Progress::finish() {
+void ProgressLine::clear() {
   if (drawn_) fmt::print(stderr, "\r{:80}\r", "");
   drawn_ = false;
 }

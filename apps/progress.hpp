@@ -1,25 +1,26 @@
 #pragma once
-// A one-line progress report for long runs on a terminal: simulated time, percent, steps per
-// second and time left, redrawn at most five times a second on stderr. Silent when stderr is not
-// a terminal or when quiet.
+// A one-line progress report for long runs on a terminal: the run, simulated time, percent, steps
+// per second and time left, redrawn at most five times a second on stderr. Silent when stderr is
+// not a terminal or when quiet.
 #include <chrono>
 #include <string>
 
+#include "rfem/studies/runs.hpp"
+
 namespace rfem::app {
 
-class Progress {
+class ProgressLine {
  public:
-  Progress(std::string label, double t_end, bool quiet);
-  /// Reports simulated time t after `steps` integrator steps.
-  void update(double t, long steps);
+  explicit ProgressLine(bool quiet);
+  /// Shows where a run is (a new run name starts its own clock).
+  void show(const Progress& p);
   /// Clears the line (before a summary is printed).
-  void finish();
+  void clear();
 
  private:
-  std::string label_;
-  double t_end_;
   bool active_;
   bool drawn_ = false;
+  std::string run_;
   std::chrono::steady_clock::time_point start_, last_;
 };
 

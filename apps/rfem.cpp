@@ -3,12 +3,12 @@
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
 #include <fmt/core.h>
-#include <omp.h>
 
 #include <Eigen/Core>
 #include <sstream>
 
-#include "apps/commands.hpp"
+#include "commands.hpp"
+#include "rfem/version.hpp"
 
 namespace {
 
@@ -34,7 +34,7 @@ const CLI::Validator kPositiveInt(
 int main(int argc, char** argv) {
   using namespace rfem::app;
   CLI::App app{"rfem: dynamics of manipulators with flexible links by the Rigid Finite Element Method"};
-  app.set_version_flag("--version", std::string("rfem ") + RFEM_VERSION);
+  app.set_version_flag("--version", std::string("rfem ") + rfem::version_string);
   app.require_subcommand(1);
   app.fallthrough();  // global options (--threads) also after the subcommand
   Common common;
@@ -53,10 +53,10 @@ int main(int argc, char** argv) {
   };
   ModesOptions mo;
   auto add_rate = [&](CLI::App* sub) {
-    sub->add_option("--rate", mo.rate, "steady rate of the chosen joint [rad/s or m/s]")->each([&](const std::string&) {
-      mo.rate_given = true;
+    sub->add_option("--rate", mo.rate.rate, "steady rate of the chosen joint [rad/s or m/s]")->each([&](const std::string&) {
+      mo.rate.given = true;
     });
-    sub->add_option("--joint", mo.joint, "joint (1-based) that --rate applies to")->check(kPositiveInt);
+    sub->add_option("--joint", mo.rate.joint, "joint (1-based) that --rate applies to")->check(kPositiveInt);
   };
 
   auto* st = app.add_subcommand("static", "static equilibrium under gravity and tip loads, joints held (or turning steadily: --rate)");
@@ -118,8 +118,7 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "rfem: error: {} (rfem --help)\n", what);
     return 2;
   }
-  if (common.threads > 0) omp_set_num_threads(common.threads);
-  Eigen::setNbThreads(1);  // we parallelise ourselves
+  Eigen::setNbThreads(1);  // librfem parallelises itself (--threads goes to each call)
   spdlog::set_default_logger(spdlog::stderr_logger_mt("rfem"));
   spdlog::set_pattern("[%H:%M:%S.%e] %v");
   spdlog::set_level(common.verbose ? spdlog::level::debug : spdlog::level::warn);

@@ -1,18 +1,21 @@
-#include "assembly/assemble.hpp"
+#include "rfem/assembly/assemble.hpp"
 
 #include <omp.h>
 
 #include <algorithm>
 
-#include "assembly/rfe_kernels.hpp"
-#include "assembly/sde_kernels.hpp"
+#include "rfem/assembly/rfe_kernels.hpp"
+#include "rfem/assembly/sde_kernels.hpp"
+#include "rfem/core/check.hpp"
 
 namespace rfem {
 
 int Parallelism::team(int n) const {
   if (n < min_rfes) return 1;
-  return threads > 0 ? threads : omp_get_max_threads();
+  return max_threads();
 }
+
+int Parallelism::max_threads() const { return threads > 0 ? threads : omp_get_max_threads(); }
 
 int Workspace::chunks(const Model& model) {
   chunk.clear();
@@ -79,6 +82,9 @@ std::vector<BaseMoments> link_moments(const Model& model, const Workspace& ws) {
 
 void generalised_forces(const Model& model, const VecX& q, const VecX& v, const VecX& a, const ForceTerms& terms,
                         VecX& F, double* dissipation, Workspace* wsp) {
+  RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
+  RFEM_CHECK_ARGUMENT_SIZE(v.size(), model.dof(), "v");
+  RFEM_CHECK_ARGUMENT_SIZE(a.size(), model.dof(), "a");
   Workspace local;
   Workspace& ws = wsp ? *wsp : local;
   const double g = terms.gravity ? model.gravity : 0.0;
@@ -212,6 +218,15 @@ void scatter_entries(const BorderedPattern& p, const int (&first)[K], const Eige
 void assemble_matrices(const Model& model, const BorderedPattern& pattern, const std::vector<int>& base_col,
                        const VecX& q, const VecX& v, const MatrixTerms& t, std::vector<double>& values,
                        const std::vector<SdeTarget>& extra, MatX* base_rows, Workspace* wsp) {
+  RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
+  RFEM_CHECK_ARGUMENT_SIZE(v.size(), model.dof(), "v");
+  RFEM_CHECK_ARGUMENT_SIZE(base_col.size(), model.m(), "base_col");
+  {
+    int unknown_joints = 0;
+    for (int c : base_col) unknown_joints += c >= 0;
+    RFEM_CHECK_ARGUMENT(pattern.size() == model.flexible_dofs() + unknown_joints,
+                        "the pattern is not the one of this model and base_col");
+  }
   Workspace local;
   Workspace& ws = wsp ? *wsp : local;
   const int N = static_cast<int>(model.nodes.size()), m = model.m(), nb = pattern.n_base(),
@@ -393,6 +408,8 @@ void assemble_matrix(const Model& model, const BorderedPattern& pattern, const s
 }
 
 Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* wsp) {
+  RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
+  RFEM_CHECK_ARGUMENT_SIZE(v.size(), model.dof(), "v");
   Workspace local;
   Workspace& ws = wsp ? *wsp : local;
   Energies E;

@@ -1,8 +1,10 @@
-#include "assembly/dense_reference.hpp"
+#include "rfem/assembly/dense_reference.hpp"
 
-#include "assembly/assemble.hpp"
-#include "assembly/sde_kernels.hpp"
-#include "core/rotation.hpp"
+#include "rfem/core/check.hpp"
+
+#include "rfem/assembly/assemble.hpp"
+#include "rfem/assembly/sde_kernels.hpp"
+#include "rfem/core/rotation.hpp"
 
 namespace rfem {
 
@@ -145,6 +147,7 @@ MatX sde_sum(const Model& model, const VecX& q, double ck, double cd) {
 }  // namespace
 
 MatX dense_mass_matrix(const Model& model, const VecX& q) {
+  RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
   const int N = model.dof();
   MatX M = MatX::Zero(N, N);
   for (const Body& b : bodies(model, q, false))
@@ -155,6 +158,7 @@ MatX dense_mass_matrix(const Model& model, const VecX& q) {
 }
 
 MatX dense_stiffness(const Model& model, const VecX& q, bool gravity) {
+  RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
   const int N = model.dof();
   MatX K = sde_sum(model, q, 1.0, 0.0);
   if (gravity)
@@ -165,6 +169,8 @@ MatX dense_stiffness(const Model& model, const VecX& q, bool gravity) {
 }
 
 MatX dense_damping(const Model& model, const VecX& q, const VecX& v) {
+  RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
+  RFEM_CHECK_ARGUMENT_SIZE(v.size(), model.dof(), "v");
   MatX C = sde_sum(model, q, 0.0, 1.0);
   for (int j = 0; j < model.m(); ++j)
     C(model.joint_index(j), model.joint_index(j)) += model.joints[j].drive.damping_derivative(v[model.joint_index(j)]);

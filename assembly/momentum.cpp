@@ -1,7 +1,8 @@
-#include "assembly/momentum.hpp"
+#include "rfem/assembly/momentum.hpp"
 
-#include "assembly/assemble.hpp"
-#include "assembly/rfe_kernels.hpp"
+#include "rfem/assembly/assemble.hpp"
+#include "rfem/assembly/rfe_kernels.hpp"
+#include "rfem/core/check.hpp"
 
 namespace rfem {
 
@@ -13,6 +14,8 @@ Vec3 vee_antisymmetric(const Mat3& A) { return Vec3(A(1, 2) - A(2, 1), A(2, 0) -
 }  // namespace
 
 Momentum momentum(const Model& model, const VecX& q, const VecX& v, Workspace* wsp) {
+  RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
+  RFEM_CHECK_ARGUMENT_SIZE(v.size(), model.dof(), "v");
   Workspace local;
   Workspace& ws = wsp ? *wsp : local;
   if (ws.zero.size() != model.dof()) ws.zero = VecX::Zero(model.dof());

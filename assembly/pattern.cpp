@@ -1,7 +1,9 @@
-#include "assembly/pattern.hpp"
+#include "rfem/assembly/pattern.hpp"
 
 #include <algorithm>
 #include <stdexcept>
+
+#include "rfem/core/check.hpp"
 
 namespace rfem {
 
@@ -21,6 +23,12 @@ BorderedPattern::BorderedPattern(std::vector<Chain> chains, int n_base) : chains
 }
 
 BorderedPattern::BorderedPattern(const Model& model, const std::vector<int>& base_col) {
+  RFEM_CHECK_ARGUMENT_SIZE(base_col.size(), model.m(), "base_col");
+  {  // unknown joints numbered after every rfe coordinate, in joint order, without gaps
+    int next = model.flexible_dofs();
+    for (int c : base_col)
+      if (c >= 0) RFEM_CHECK_ARGUMENT(c == next++, "base_col must number the unknown joints after the rfe coordinates, in order");
+  }
   const int n6 = model.chain_dofs();
   nb_ = Model::rfe_dofs * model.carrying;
   for (int c : base_col) nb_ += c >= 0;

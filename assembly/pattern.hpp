@@ -15,7 +15,7 @@
 #include <mutex>
 #include <vector>
 
-#include "core/model.hpp"
+#include "rfem/core/model.hpp"
 
 namespace rfem {
 

@@ -1,4 +1,4 @@
-#include "assembly/rfe_kernels.hpp"
+#include "rfem/assembly/rfe_kernels.hpp"
 
 namespace rfem {
 

@@ -1,4 +1,4 @@
-#include "assembly/sde_kernels.hpp"
+#include "rfem/assembly/sde_kernels.hpp"
 
 namespace rfem {
 

@@ -6,19 +6,22 @@
 #include <algorithm>
 #include <vector>
 
-#include "core/kinematics.hpp"
+#include "rfem/core/kinematics.hpp"
 
 namespace rfem {
 
 /// How many threads the per-rfe loops use.
 struct Parallelism {
-  int threads = 0;     ///< team size (0: omp_get_max_threads())
+  int threads = 0;     ///< team size (0: max_threads(), OpenMP's default: OMP_NUM_THREADS or the cores)
   int min_rfes = 256;  ///< fewer rfes run on one thread: a parallel region costs more than it saves
   /// rfes per chunk: the unit of work and of partial sums. Results depend on it (summation
   /// order), never on the thread count; tests make it small to exercise the chunk boundaries.
   int chunk = 64;
   /// Team size for a loop over n rfes.
   int team(int n) const;
+  /// The largest team: `threads`, or OpenMP's default if 0 (read, never set: the caller's
+  /// omp_set_num_threads is the caller's business).
+  int max_threads() const;
 };
 
 /// Σ over bodies of what the base rows need: Y = W H Ẅᵀ (rigid links), G = W H Wᵀ, s = W H e₄,
@@ -38,6 +41,8 @@ struct BaseMoments {
 };
 
 struct Workspace {
+  Workspace() = default;
+  explicit Workspace(const Parallelism& p) : parallel(p) {}
   Parallelism parallel;
   BaseKinematics bk;
   /// A chunk: rfes begin … end − 1 of one link (chunks never span two links).

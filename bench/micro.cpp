@@ -14,10 +14,10 @@
 #include <memory>
 #include <random>
 
-#include "assembly/assemble.hpp"
-#include "cases/case_file.hpp"
-#include "core/rotation.hpp"
-#include "solvers/newton_system.hpp"
+#include "rfem/assembly/assemble.hpp"
+#include "rfem/cases/case_file.hpp"
+#include "rfem/core/rotation.hpp"
+#include "rfem/solvers/newton_system.hpp"
 
 using namespace rfem;
 
@@ -75,7 +75,7 @@ struct LinksSetup {
     random_state(model, 1e-6, q, v, a);  // (a light strip: small deformation keeps S positive definite)
     for (int j = 0; j < model.m(); ++j) base_col.push_back(model.joint_index(j));
     ws.parallel.threads = 1;
-    ns = std::make_unique<NewtonSystem>(model, base_col, LinearSolverKind::Chain, &ws);
+    ns = std::make_unique<NewtonSystem>(std::make_shared<const Model>(model), base_col, LinearSolverKind::Chain);
   }
 };
 
@@ -83,12 +83,13 @@ void per_rfe(benchmark::State& state);
 
 // Newton solves with the system set up at the state (s: Setup or LinksSetup).
 template <class S>
-void solve_loop(benchmark::State& state, const S& s, NewtonSystem& ns) {
-  if (!ns.setup(s.q, s.v, 0.005)) state.SkipWithError("the Newton matrix is not positive definite");
+void solve_loop(benchmark::State& state, const S& s, NewtonSystem& ns, Workspace& ws) {
+  if (!ns.setup(s.q, s.v, 0.005, ws)) state.SkipWithError("the Newton matrix is not positive definite");
   VecX b = VecX::Ones(ns.size()), x;
+  const int team = ws.parallel.team(s.model.n());
   for (auto _ : state) {
     x = b;
-    ns.solve(x);
+    ns.solve(x, team);
     benchmark::DoNotOptimize(x.data());
   }
   per_rfe(state);
@@ -107,13 +108,13 @@ void BM_LinksResidual(benchmark::State& state) {
 void BM_LinksStep(benchmark::State& state) {
   LinksSetup s(state);
   VecX F, x;
-  if (!s.ns->setup(s.q, s.v, 0.005)) state.SkipWithError("the Newton matrix is not positive definite");
+  if (!s.ns->setup(s.q, s.v, 0.005, s.ws)) state.SkipWithError("the Newton matrix is not positive definite");
   for (auto _ : state) {
-    benchmark::DoNotOptimize(s.ns->setup(s.q, s.v, 0.005));
+    benchmark::DoNotOptimize(s.ns->setup(s.q, s.v, 0.005, s.ws));
     for (int i = 0; i < 12; ++i) {
       generalised_forces(s.model, s.q, s.v, s.a, ForceTerms{}, F, nullptr, &s.ws);
       x = F.head(s.ns->size());
-      s.ns->solve(x);
+      s.ns->solve(x, 1);
       benchmark::DoNotOptimize(x.data());
     }
   }
@@ -122,13 +123,13 @@ void BM_LinksStep(benchmark::State& state) {
 
 void BM_LinksSetup(benchmark::State& state) {  // assembly + factorisation of S
   LinksSetup s(state);
-  for (auto _ : state) benchmark::DoNotOptimize(s.ns->setup(s.q, s.v, 0.005));
+  for (auto _ : state) benchmark::DoNotOptimize(s.ns->setup(s.q, s.v, 0.005, s.ws));
   per_rfe(state);
 }
 
 void BM_LinksSolve(benchmark::State& state) {
   LinksSetup s(state);
-  solve_loop(state, s, *s.ns);
+  solve_loop(state, s, *s.ns, s.ws);
 }
 
 void links_args(benchmark::internal::Benchmark* b) {
@@ -163,8 +164,10 @@ void BM_Residual(benchmark::State& state) {
 void BM_NewtonSetup(benchmark::State& state) {
   threads(state);
   Setup s(static_cast<int>(state.range(0)));
-  NewtonSystem ns(s.model, s.base_col, state.range(2) ? LinearSolverKind::Cholmod : LinearSolverKind::Chain);
-  for (auto _ : state) benchmark::DoNotOptimize(ns.setup(s.q, s.v, 0.005));
+  NewtonSystem ns(std::make_shared<const Model>(s.model), s.base_col, state.range(2) ? LinearSolverKind::Cholmod : LinearSolverKind::Chain);
+  Workspace ws;
+  ws.parallel.threads = static_cast<int>(state.range(1));
+  for (auto _ : state) benchmark::DoNotOptimize(ns.setup(s.q, s.v, 0.005, ws));
   per_rfe(state);
 }
 
@@ -189,8 +192,10 @@ void BM_NewtonAssembly(benchmark::State& state) {  // S alone
 void BM_Solve(benchmark::State& state) {
   threads(state);
   Setup s(static_cast<int>(state.range(0)));
-  NewtonSystem ns(s.model, s.base_col, state.range(2) ? LinearSolverKind::Cholmod : LinearSolverKind::Chain);
-  solve_loop(state, s, ns);
+  NewtonSystem ns(std::make_shared<const Model>(s.model), s.base_col, state.range(2) ? LinearSolverKind::Cholmod : LinearSolverKind::Chain);
+  Workspace ws;
+  ws.parallel.threads = static_cast<int>(state.range(1));
+  solve_loop(state, s, ns, ws);
 }
 
 void args(benchmark::internal::Benchmark* b) {

@@ -1,9 +1,9 @@
-#include "cases/case_file.hpp"
+#include "rfem/cases/case_file.hpp"
 
 #include <filesystem>
 #include <fstream>
 
-#include "cases/case_reading.hpp"
+#include "rfem/cases/case_reading_impl.hpp"
 
 namespace rfem {
 
@@ -75,9 +75,9 @@ Simulation read_simulation(const Reader& r, const toml::table& t) {
   o.atol = r.positive(t, p, "atol", o.atol);
   o.atol_velocity = r.positive(t, p, "atol_velocity", o.atol_velocity);
   o.max_step = r.non_negative(t, p, "max_step", o.max_step);
-  s.procedure = r.string(t, p, "procedure", s.procedure);
-  if (s.procedure != "single" && s.procedure != "paper")
-    r.fail(t.get("procedure"), p + ".procedure", "must be \"single\" or \"paper\" (got \"" + s.procedure + "\")");
+  const std::string procedure = r.string(t, p, "procedure", to_string(s.procedure));
+  if (!parse(procedure, s.procedure))
+    r.fail(t.get("procedure"), p + ".procedure", "must be \"single\" or \"paper\" (got \"" + procedure + "\")");
   s.flexible_every = static_cast<int>(r.integer(t, p, "store_flexible_every", s.flexible_every, 0, 1000000000));
   const std::string kind = r.string(t, p, "integrator", integrator_name(o.kind));
   if (!parse_integrator(kind, o.kind))
@@ -107,14 +107,27 @@ Simulation read_simulation(const Reader& r, const toml::table& t) {
 }  // namespace
 
 Case read_case(const std::string& path, const std::vector<std::string>& overrides) {
-  Case c;
-  c.path = path;
   std::ifstream in(path);
   if (std::filesystem::is_directory(path)) throw CaseError(path + ": is a directory, not a case file (e.g. " + path + "/paper_deployment.toml)");
   if (!in) throw CaseError(path + ": cannot open case file");
   std::stringstream buf;
   buf << in.rdbuf();
-  c.text = buf.str();
+  const auto slash = path.find_last_of('/');
+  return parse_case(buf.str(), path, overrides, slash == std::string::npos ? std::string() : path.substr(0, slash + 1));
+}
+
+Case with_overrides(const Case& c, const std::vector<std::string>& more) {
+  std::vector<std::string> all = c.overrides;
+  all.insert(all.end(), more.begin(), more.end());
+  return parse_case(c.text, c.path, all, c.base_dir);
+}
+
+Case parse_case(const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
+                const std::string& base_dir) {
+  Case c;
+  c.path = path;
+  c.base_dir = base_dir.empty() || base_dir.back() == '/' ? base_dir : base_dir + "/";
+  c.text = text;
   toml::table root;
   try {
     root = toml::parse(c.text, path);
@@ -132,8 +145,7 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
   }
   const Reader r(path);
   r.check_keys(root, "", {"case", "materials", "sections", "link", "links", "joints", "gravity", "loads", "simulation", "base"});
-  const auto slash = path.find_last_of('/');
-  const std::string case_dir = slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
+  const std::string& case_dir = c.base_dir;
 
   if (const toml::node* n = root.get("case")) {
     if (!n->is_table()) r.fail(n, "case", "must be a table");
@@ -147,7 +159,7 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
   read_links(r, root, mats, secs, c, link_parents);
   read_joints(r, root, mats, secs, case_dir, c, joint_parents);
   if (const toml::node* bn = root.get("base")) read_base(r, bn, mats, secs, path, c, joint_parents);
-  resolve_mountings(r, c, joint_parents, link_parents);
+  resolve_parents(r, c, joint_parents, link_parents);
   if (!c.has_link() && c.joints.empty()) r.fail(&root, "link", "a case needs a flexible link, joints, or both");
 
   if (const toml::node* gn = root.get("gravity")) {
@@ -159,13 +171,13 @@ Case read_case(const std::string& path, const std::vector<std::string>& override
     if (!sn->is_table()) r.fail(sn, "simulation", "must be a table");
     c.sim = read_simulation(r, *sn->as_table());
     c.has_simulation = true;
-    if (c.sim.procedure == "paper" && c.free_base)
+    if (c.sim.procedure == Procedure::Paper && c.free_base)
       r.fail(sn->as_table()->get("procedure"), "simulation.procedure",
              "the paper procedure prescribes every joint; a free base has none to prescribe");
-    if (c.sim.procedure == "paper")
+    if (c.sim.procedure == Procedure::Paper)
       for (const InputSpec& in : c.inputs)
         if (!in.prescribed())
-          throw CaseError(in.where + ": the paper procedure needs a motion law on every joint (got '" + in.kind + "')");
+          throw CaseError(in.where + ": the paper procedure needs a motion law on every joint (got '" + to_string(in.kind) + "')");
   }
   if (const toml::node* ln = root.get("loads")) {
     if (!ln->is_table()) r.fail(ln, "loads", "must be a table");

@@ -1,16 +1,19 @@
 #pragma once
-#include <memory>
 // Case files: human-edited TOML describing materials, sections, the flexible links' segments and
-// discretisation, the joints and their rigid bodies, what each is mounted on, gravity and loads. Every key is checked;
-// a bad file raises CaseError with a one-line "file:line: key: what is wrong" message.
-// The format is documented in README.md ("Case files").
+// discretisation, the joints and their rigid bodies, what each is mounted on, gravity and loads.
+// Every key is checked; a bad file raises CaseError with a one-line "file:line: key: what is wrong"
+// message. A case is a value: read from a file or from TOML text, changed with the paths of
+// `rfem --set` (read and checked again), copied freely. The format is documented in README.md
+// ("Case files").
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "core/model.hpp"
-#include "solvers/integrator.hpp"
-#include "solvers/statics.hpp"
+#include "rfem/cases/names.hpp"
+#include "rfem/core/model.hpp"
+#include "rfem/solvers/integrator.hpp"
+#include "rfem/solvers/statics.hpp"
 
 namespace rfem {
 
@@ -21,7 +24,7 @@ class CaseError : public std::runtime_error {
 
 /// A joint's input in a time integration (`joints[].input`); the kinds are documented in README.md.
 struct InputSpec {
-  std::string kind = "torque";  ///< deployment | spinup | constant_rate | table | torque | torque_table | torque_from_run | pd
+  InputKind kind = InputKind::Torque;
   double alpha = 0, T = 0, Omega = 0, rate = 0, value = 0;
   std::string file;  ///< table or results file, resolved relative to the case file
   std::string run;   ///< group in a results file
@@ -31,15 +34,15 @@ struct InputSpec {
   /// prescribed kinds, from the joint's value); feedforward "none" or "rigid" (computed torque).
   std::shared_ptr<InputSpec> reference;
   double kp = 0, kd = 0;
-  std::string feedforward = "none";
-  bool prescribed() const { return kind == "deployment" || kind == "spinup" || kind == "constant_rate" || kind == "table"; }
+  Feedforward feedforward = Feedforward::None;
+  bool prescribed() const { return is_motion(kind); }
 };
 
 /// The `[simulation]` table: the integrator's settings (their defaults are IntegratorOptions') and
 /// what to run and store.
 struct Simulation {
   IntegratorOptions options;
-  std::string procedure = "single";  ///< single | paper (rigid inverse dynamics, kinematic, force input)
+  Procedure procedure = Procedure::Single;  ///< single, or paper (rigid inverse dynamics, kinematic, force input)
   int flexible_every = 0;            ///< store the full flexible state every k outputs (0: never)
 };
 
@@ -53,8 +56,9 @@ struct LinkCase {
 };
 
 struct Case {
-  std::string path;
-  std::string text;  ///< the file as read (stored with results)
+  std::string path;      ///< the file (or the name given to parse_case): messages start with it
+  std::string base_dir;  ///< where relative table and results paths are found ("" or ending in '/')
+  std::string text;      ///< the file as read (stored with results)
   std::string effective_text;          ///< the case after the overrides, as TOML
   std::vector<std::string> overrides;  ///< the --set key.path=value strings applied
   std::vector<std::string> warnings;   ///< legal but suspicious values ("file:line: key: …")
@@ -77,9 +81,17 @@ struct Case {
   bool has_simulation = false;
 };
 
-/// Reads and validates a case; `overrides` are "key.path=value" strings applied before checking
-/// (array elements by index: "joints.0.value=0.5", "link.segments.1.parts=4").
+/// Reads and validates a case file; `overrides` are "key.path=value" strings applied before
+/// checking (array elements by index: "joints.0.value=0.5", "link.segments.1.parts=4"; a bare word
+/// is a string). Throws CaseError.
 Case read_case(const std::string& path, const std::vector<std::string>& overrides = {});
+/// The same from TOML text: `name` stands for the file in messages, relative table paths are
+/// resolved against `base_dir` (default: the current directory).
+Case parse_case(const std::string& text, const std::string& name = "<text>",
+                const std::vector<std::string>& overrides = {}, const std::string& base_dir = "");
+/// The case with further overrides (after its own), read again from its text and checked as the
+/// file is: a bad value is a CaseError naming the key.
+Case with_overrides(const Case& c, const std::vector<std::string>& more);
 
 /// Builds the model with n rfes in all (n > 0: distributed over every link's segments by length;
 /// n == 0: each link's own discretisation). Throws CaseError for an impossible discretisation.

@@ -1,8 +1,8 @@
 // Materials, sections, rigid bodies and joint drives of a case file.
 #include <cmath>
 
-#include "cases/case_reading.hpp"
-#include "core/rotation.hpp"
+#include "rfem/cases/case_reading_impl.hpp"
+#include "rfem/core/rotation.hpp"
 
 namespace rfem::reading {
 

@@ -2,7 +2,7 @@
 #include <cmath>
 #include <fstream>
 
-#include "cases/case_reading.hpp"
+#include "rfem/cases/case_reading_impl.hpp"
 
 namespace rfem::reading {
 
@@ -14,35 +14,37 @@ InputSpec read_input(const Reader& r, const toml::table& t, const std::string& p
   if (t.source().begin.line) where << ":" << t.source().begin.line;
   where << ": " << path;
   in.where = where.str();
-  in.kind = r.string(t, path, "kind");
+  const std::string kind = r.string(t, path, "kind");
+  if (!parse(kind, in.kind))
+    r.fail(t.get("kind"), path + ".kind", "unknown input '" + kind + "' (" + input_kind_names() + ")");
   auto file_key = [&]() {
     const std::string f = r.string(t, path, "file");
     in.file = (f.empty() || f[0] == '/') ? f : case_dir + f;
     if (!std::ifstream(in.file)) r.fail(t.get("file"), path + ".file", "cannot open '" + in.file + "'");
   };
-  if (in.kind == "deployment") {
+  if (in.kind == InputKind::Deployment) {
     r.check_keys(t, path, {"kind", "alpha", "T"});
     in.alpha = r.number(t, path, "alpha");
     in.T = r.positive(t, path, "T");
-  } else if (in.kind == "spinup") {
+  } else if (in.kind == InputKind::Spinup) {
     r.check_keys(t, path, {"kind", "Omega", "T"});
     in.Omega = r.number(t, path, "Omega");
     in.T = r.positive(t, path, "T");
-  } else if (in.kind == "constant_rate") {
+  } else if (in.kind == InputKind::ConstantRate) {
     r.check_keys(t, path, {"kind", "rate"});
     in.rate = r.number(t, path, "rate");
-  } else if (in.kind == "table" || in.kind == "torque_table") {
+  } else if (in.kind == InputKind::Table || in.kind == InputKind::TorqueTable) {
     r.check_keys(t, path, {"kind", "file"});
     file_key();
-  } else if (in.kind == "torque") {
+  } else if (in.kind == InputKind::Torque) {
     r.check_keys(t, path, {"kind", "value"});
     in.value = r.number(t, path, "value", 0.0);
-  } else if (in.kind == "torque_from_run") {
+  } else if (in.kind == InputKind::TorqueFromRun) {
     r.check_keys(t, path, {"kind", "file", "run", "joint"});
     file_key();
     in.run = r.string(t, path, "run");
     in.joint = static_cast<int>(r.integer(t, path, "joint", 0, 1, 1000));
-  } else if (in.kind == "pd") {
+  } else if (in.kind == InputKind::Pd) {
     r.check_keys(t, path, {"kind", "reference", "kp", "kd", "feedforward"});
     const toml::node* rn = t.get("reference");
     if (!rn || !rn->is_table())
@@ -52,12 +54,9 @@ InputSpec read_input(const Reader& r, const toml::table& t, const std::string& p
       r.fail(rn, path + ".reference.kind", "the reference must be a motion (deployment, spinup, constant_rate, table)");
     in.kp = r.non_negative(t, path, "kp", 0.0);
     in.kd = r.non_negative(t, path, "kd", 0.0);
-    in.feedforward = r.string(t, path, "feedforward", std::string("none"));
-    if (in.feedforward != "none" && in.feedforward != "rigid")
-      r.fail(t.get("feedforward"), path + ".feedforward", "must be \"none\" or \"rigid\" (got \"" + in.feedforward + "\")");
-  } else {
-    r.fail(t.get("kind"), path + ".kind",
-           "unknown input '" + in.kind + "' (deployment, spinup, constant_rate, table, torque, torque_table, torque_from_run, pd)");
+    const std::string ff = r.string(t, path, "feedforward", std::string("none"));
+    if (!parse(ff, in.feedforward))
+      r.fail(t.get("feedforward"), path + ".feedforward", "must be \"none\" or \"rigid\" (got \"" + ff + "\")");
   }
   return in;
 }

@@ -2,7 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "cases/case_reading.hpp"
+#include "rfem/cases/case_reading_impl.hpp"
 
 namespace rfem::reading {
 
@@ -94,12 +94,11 @@ void read_links(const Reader& r, const toml::table& root, const Materials& mats,
   }
 }
 
-void resolve_mountings(const Reader& r, Case& c, const std::vector<ParentRef>& joint_parents,
+void resolve_parents(const Reader& r, Case& c, const std::vector<ParentRef>& joint_parents,
                        const std::vector<ParentRef>& link_parents) {
   const int m = static_cast<int>(c.joints.size()), nl = static_cast<int>(c.links.size());
   // Names: unique among joints and links, and not "ground".
   std::map<std::string, Entity> named;
-  auto name_of = [&](const Entity& e) { return e.kind == Mounting::Kind::Joint ? c.joints[e.index].name : c.links[e.index].name; };
   auto add = [&](const std::string& name, const Entity& e, const ParentRef& pr) {
     const std::string key = pr.path == "base" ? "base" : pr.path + ".name";
     if (name == "ground") r.fail(pr.node, key, "'ground' is reserved for the inertial frame");
@@ -147,45 +146,21 @@ void resolve_mountings(const Reader& r, Case& c, const std::vector<ParentRef>& j
   };
   for (int j = 0; j < m; ++j) c.joints[j].on = mounting(joint_parents[j], true);
   for (int l = 0; l < nl; ++l) c.links[l].on = mounting(link_parents[l], false);
-  // The one link's default: the last joint of the chain from the ground (a joint that sits on the
-  // link, a wrist, comes after it).
-  auto on_a_link = [&](int j) {
-    for (int steps = 0; j >= 0 && steps <= m; ++steps) {
-      const Mounting& on = c.joints[j].on;
-      if (on.kind == Mounting::Kind::Link) return true;
-      j = on.kind == Mounting::Kind::Joint ? on.index : on.kind == Mounting::Kind::Chain ? j - 1 : -1;
-    }
-    return false;
-  };
-  for (int l = 0; l < nl; ++l) {
-    Mounting& on = c.links[l].on;
-    if (on.kind != Mounting::Kind::Chain) continue;
-    int j = m - 1;
-    while (j >= 0 && on_a_link(j)) --j;
-    on.kind = j >= 0 ? Mounting::Kind::Joint : Mounting::Kind::Ground;
-    on.index = j;
+  // The defaults (a link on the last joint of the chain from the ground), the points and the
+  // cycles: the model's rule (core/mounting.hpp), reported at the parent key of whom it concerns.
+  std::vector<Mounting> jon, lon;
+  std::vector<std::string> jn, ln;
+  std::vector<double> len;
+  for (const Joint& j : c.joints) jon.push_back(j.on), jn.push_back(j.name);
+  for (const LinkCase& l : c.links) lon.push_back(l.on), ln.push_back(l.name), len.push_back(l.link.total_length());
+  try {
+    rfem::resolve_mountings(jon, lon, jn, ln, len);
+  } catch (const MountingError& e) {
+    const ParentRef& pr = e.joint ? joint_parents[e.index] : link_parents[e.index];
+    r.fail(pr.node, pr.path + ".parent", e.what());
   }
-  // No cycles: from every joint and link, the parents lead to the ground.
-  auto parent = [&](const Entity& e) {
-    const Mounting& on = e.kind == Mounting::Kind::Joint ? c.joints[e.index].on : c.links[e.index].on;
-    if (on.kind != Mounting::Kind::Chain) return Entity{on.kind, on.index};
-    const int j = e.kind == Mounting::Kind::Joint ? e.index - 1 : m - 1;
-    return j >= 0 ? Entity{Mounting::Kind::Joint, j} : Entity{};
-  };
-  for (int start = 0; start < m + nl; ++start) {
-    const Entity first = start < m ? Entity{Mounting::Kind::Joint, start} : Entity{Mounting::Kind::Link, start - m};
-    std::string chain = name_of(first);
-    Entity e = first;
-    for (int steps = 0; steps <= m + nl; ++steps) {
-      e = parent(e);
-      if (e.kind == Mounting::Kind::Ground) break;
-      chain += " -> " + name_of(e);
-      if (e.kind == first.kind && e.index == first.index) {
-        const ParentRef& pr = first.kind == Mounting::Kind::Joint ? joint_parents[first.index] : link_parents[first.index];
-        r.fail(pr.node, pr.path + ".parent", "the mountings form a cycle (" + chain + ")");
-      }
-    }
-  }
+  for (int j = 0; j < m; ++j) c.joints[j].on = jon[j];
+  for (int l = 0; l < nl; ++l) c.links[l].on = lon[l];
 }
 
 }  // namespace rfem::reading

@@ -1,6 +1,6 @@
-#include "core/base_chain.hpp"
+#include "rfem/core/base_chain.hpp"
 
-#include "core/rotation.hpp"
+#include "rfem/core/rotation.hpp"
 
 namespace rfem {
 

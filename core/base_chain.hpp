@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "core/joint_drive.hpp"
-#include "core/mounting.hpp"
-#include "core/types.hpp"
+#include "rfem/core/joint_drive.hpp"
+#include "rfem/core/mounting.hpp"
+#include "rfem/core/types.hpp"
 
 namespace rfem {
 

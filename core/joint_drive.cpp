@@ -1,8 +1,17 @@
-#include "core/joint_drive.hpp"
+#include "rfem/core/joint_drive.hpp"
 
 #include <cmath>
 
+#include "rfem/core/check.hpp"
+
 namespace rfem {
+
+void JointDrive::check() const {
+  require_non_negative("drive inertia", inertia);
+  require_non_negative("drive damping", damping);
+  require_non_negative("drive friction", friction);
+  require_positive("drive friction_velocity", friction_velocity);
+}
 
 double JointDrive::dissipative_force(double v) const {
   return damping * v + (friction != 0.0 ? friction * std::tanh(v / friction_velocity) : 0.0);

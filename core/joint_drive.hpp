@@ -1,5 +1,5 @@
 #pragma once
-// What a joint's drive adds to its generalised force (issue 10 §6): the reflected inertia of rotor
+// What a joint's drive adds to its generalised force: the reflected inertia of rotor
 // and gearbox, viscous damping and Coulomb friction smoothed by tanh,
 //   τ_drive(q̇, q̈) = J q̈ + c q̇ + F_c tanh(q̇ / v_s).
 // The drive's kinetic energy is ½ J q̇², the power it dissipates c q̇² + F_c q̇ tanh(q̇ / v_s) ≥ 0.
@@ -24,6 +24,9 @@ struct JointDrive {
   /// d(power)/dq̇.
   double power_derivative(double v) const { return dissipative_force(v) + v * damping_derivative(v); }
   double kinetic_energy(double v) const { return 0.5 * inertia * v * v; }
+  /// Throws std::invalid_argument unless inertia, damping, friction ≥ 0 and friction_velocity > 0
+  /// (finite): the dissipated power is then never negative.
+  void check() const;
 };
 
 }  // namespace rfem

@@ -1,8 +1,13 @@
-#include "core/kinematics.hpp"
+#include "rfem/core/kinematics.hpp"
+
+#include "rfem/core/check.hpp"
 
 namespace rfem {
 
 void base_kinematics(const Model& model, const VecX& q, const VecX& v, const VecX& a, BaseKinematics& out) {
+  RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
+  RFEM_CHECK_ARGUMENT_SIZE(v.size(), model.dof(), "v");
+  RFEM_CHECK_ARGUMENT_SIZE(a.size(), model.dof(), "a");
   const int N = static_cast<int>(model.nodes.size());
   for (auto* x : {&out.W, &out.Xi, &out.Wd, &out.Wdd, &out.Omega, &out.Alpha}) x->resize(N);
   for (int i = 0; i < N; ++i) {

@@ -1,11 +1,36 @@
-#include "core/link.hpp"
+#include "rfem/core/link.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
+#include "rfem/core/check.hpp"
+
 namespace rfem {
+
+void FlexibleLink::check() const {
+  if (segments.empty()) throw std::invalid_argument("a flexible link needs at least one segment");
+  for (size_t s = 0; s < segments.size(); ++s) {
+    const Segment& seg = segments[s];
+    const std::string who = "segment " + std::to_string(s + 1) + ": ";
+    require_positive(who + "length", seg.length);
+    if (seg.parts < 1) throw std::invalid_argument(who + "parts must be at least 1 (got " + std::to_string(seg.parts) + ")");
+    seg.material.check();
+    seg.section.check();
+  }
+  require_non_negative("damping_beta", damping_beta);
+  const double L = total_length();
+  for (size_t i = 0; i < payloads.size(); ++i) {
+    const std::string who = "payload " + std::to_string(i + 1) + ": ";
+    require_finite(who + "at", payloads[i].at);
+    if (payloads[i].at < 0.0 || payloads[i].at > L * (1 + 1e-12))
+      throw std::invalid_argument(who + "at = " + std::to_string(payloads[i].at) + " m is off the link (0 to " +
+                                  std::to_string(L) + " m)");
+    require_positive(who + "mass", payloads[i].H(3, 3));
+    if (!payloads[i].H.allFinite()) throw std::invalid_argument(who + "inertia must be finite");
+  }
+}
 
 double FlexibleLink::total_length() const {
   double L = 0.0;
@@ -120,6 +145,7 @@ Discretisation Discretisation::rigid() const {
 }
 
 Discretisation discretise(const FlexibleLink& link) {
+  link.check();
   Discretisation d;
   d.length = link.total_length();
   d.damping_beta = link.damping_beta;

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "core/section.hpp"
+#include "rfem/core/section.hpp"
 
 namespace rfem {
 
@@ -16,7 +16,7 @@ struct Segment {
   int parts = 1;        ///< equal parts (= sdes) in this segment
 };
 
-/// A rigid body fixed to the link (issue 10 §4): a point mass or a body with inertia, e.g. an end
+/// A rigid body fixed to the link: a point mass or a body with inertia, e.g. an end
 /// effector at the tip. It moves with the rfe whose span contains `at` (the last rfe for the tip),
 /// whose mass, mass centre and inertia it joins.
 struct Payload {
@@ -29,6 +29,9 @@ struct FlexibleLink {
   std::vector<Payload> payloads;
   double damping_beta = 0.0;  ///< stiffness-proportional sde damping d = β c [s]
   double total_length() const;
+  /// Throws std::invalid_argument unless the link has segments of positive length with at least
+  /// one part each, valid materials and sections, β ≥ 0, and payloads of positive mass on it.
+  void check() const;
 };
 
 /// Rigid finite element: mass, mass centre and pseudo-inertia [3.7] in its own frame, whose axes

@@ -1,7 +1,10 @@
-#include "core/model.hpp"
+#include "rfem/core/model.hpp"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include "rfem/core/check.hpp"
 
 namespace rfem {
 
@@ -12,28 +15,6 @@ Mat4 translation(const Vec3& t) { return homogeneous(Mat3::Identity(), t); }
 std::string what(const Model& M, bool joint, int i) {
   return joint ? "joint " + std::to_string(i + 1) + " (" + M.joints[i].name + ")"
                : "link " + std::to_string(i + 1) + " (" + M.links[i].name + ")";
-}
-
-// Resolves the default and checks the target; a point on a link becomes 0 … L.
-void resolve(const Model& M, bool joint, int i, Mounting& on) {
-  if (on.kind == Mounting::Kind::Chain) {
-    const int j = joint ? i - 1 : M.m() - 1;
-    on.kind = j >= 0 ? Mounting::Kind::Joint : Mounting::Kind::Ground;
-    on.index = j;
-  }
-  const std::string who = what(M, joint, i);
-  if (on.kind == Mounting::Kind::Joint && (on.index < 0 || on.index >= M.m()))
-    throw std::invalid_argument(who + " is mounted on joint " + std::to_string(on.index + 1) + ", which does not exist");
-  if (on.kind == Mounting::Kind::Link) {
-    if (on.index < 0 || on.index >= static_cast<int>(M.links.size()))
-      throw std::invalid_argument(who + " is mounted on link " + std::to_string(on.index + 1) + ", which does not exist");
-    const double L = M.links[on.index].d.length;
-    if (on.at < 0) on.at = L;
-    if (on.at > L * (1 + 1e-12))
-      throw std::invalid_argument(who + " is mounted at " + std::to_string(on.at) + " m on " + what(M, false, on.index) +
-                                  ", which is " + std::to_string(L) + " m long");
-    on.at = std::min(on.at, L);
-  }
 }
 
 // The rfe of link l that a mounting at `at` rides on (−1: rfe_0, rigid with {r}, or a rigid link).
@@ -139,8 +120,28 @@ Model make_model(std::vector<Joint> joints, std::vector<MountedLink> links, doub
   M.gravity = gravity;
   M.free_base = free_base;
   const int m = M.m(), nl = static_cast<int>(M.links.size());
-  for (int j = 0; j < m; ++j) resolve(M, true, j, M.joints[j].on);
-  for (int l = 0; l < nl; ++l) resolve(M, false, l, M.links[l].on);
+  for (int j = 0; j < m; ++j) {
+    const Joint& jt = M.joints[j];
+    try {
+      jt.drive.check();
+      if (!jt.H.allFinite() || !(jt.H(3, 3) >= 0.0)) throw std::invalid_argument("its body's inertia must be finite, its mass not negative");
+      if (!jt.axis.allFinite() || std::abs(jt.axis.norm() - 1.0) > 1e-9) throw std::invalid_argument("its axis must be a unit vector");
+      for (double x : {jt.alpha, jt.a, jt.theta, jt.d}) require_finite("its DH parameters", x);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(what(M, true, j) + ": " + e.what());
+    }
+  }
+  require_non_negative("gravity", M.gravity);
+  {  // defaults and checks of every mounting (core/mounting.hpp)
+    std::vector<Mounting> jon, lon;
+    std::vector<std::string> jn, ln;
+    std::vector<double> len;
+    for (const Joint& j : M.joints) jon.push_back(j.on), jn.push_back(j.name);
+    for (const MountedLink& L : M.links) lon.push_back(L.on), ln.push_back(L.name), len.push_back(L.d.length);
+    resolve_mountings(jon, lon, jn, ln, len);
+    for (int j = 0; j < m; ++j) M.joints[j].on = jon[j];
+    for (int l = 0; l < nl; ++l) M.links[l].on = lon[l];
+  }
   // Which rfes carry something (derived fields of links given again are recomputed).
   for (MountedLink& L : M.links) {
     L.carrier.assign(L.n(), -1);
@@ -185,10 +186,7 @@ Model make_model(std::vector<Joint> joints, std::vector<MountedLink> links, doub
         joint_done[j] = progress = true;
       }
   }
-  for (int j = 0; j < m; ++j)
-    if (!joint_done[j]) throw std::invalid_argument(what(M, true, j) + " is part of a cycle of mountings");
-  for (int l = 0; l < nl; ++l)
-    if (!link_done[l]) throw std::invalid_argument(what(M, false, l) + " is part of a cycle of mountings");
+  // (resolve_mountings refused cycles: everything is placed)
   return M;
 }
 

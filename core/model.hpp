@@ -14,9 +14,9 @@
 // this layout: other code asks rfe_index / joint_index instead of computing offsets.
 #include <string>
 
-#include "core/base_chain.hpp"
-#include "core/link.hpp"
-#include "core/mounting.hpp"
+#include "rfem/core/base_chain.hpp"
+#include "rfem/core/link.hpp"
+#include "rfem/core/mounting.hpp"
 
 namespace rfem {
 

@@ -1,4 +1,4 @@
-#include "core/rotation.hpp"
+#include "rfem/core/rotation.hpp"
 
 #include <cmath>
 

@@ -1,8 +1,28 @@
-#include "core/section.hpp"
+#include "rfem/core/section.hpp"
 
 #include <cmath>
 
+#include "rfem/core/check.hpp"
+
 namespace rfem {
+
+void Material::check() const {
+  const std::string who = "material " + name + ": ";
+  require_positive(who + "E", E);
+  require_positive(who + "G", G);
+  require_positive(who + "rho", rho);
+}
+
+void Section::check() const {
+  const std::string who = "section " + name + ": ";
+  require_positive(who + "A", A);
+  require_positive(who + "Iy", Iy);
+  require_positive(who + "Iz", Iz);
+  require_positive(who + "J", J);
+  require_positive(who + "kappa_y", kappa_y);
+  require_positive(who + "kappa_z", kappa_z);
+  for (int i = 1; i < 3; ++i) require_finite(who + "offset", offset[i]);
+}
 
 Section box_section(const std::string& name, double outer, double inner) {
   Section s;

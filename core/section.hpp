@@ -2,7 +2,7 @@
 // Materials and beam cross-sections of a flexible link. SI units.
 #include <string>
 
-#include "core/types.hpp"
+#include "rfem/core/types.hpp"
 
 namespace rfem {
 
@@ -11,6 +11,8 @@ struct Material {
   double E = 0.0;    ///< Young's modulus [Pa]
   double G = 0.0;    ///< shear modulus [Pa]
   double rho = 0.0;  ///< density [kg/m³]
+  /// Throws std::invalid_argument unless E, G and rho are positive.
+  void check() const;
 };
 
 /// A cross-section in the link frame: the link axis is x, the section lies in y–z.
@@ -24,6 +26,8 @@ struct Section {
   double kappa_y = 5.0 / 6.0;  ///< shear coefficient for shear along y
   double kappa_z = 5.0 / 6.0;  ///< shear coefficient for shear along z
   Vec3 offset = Vec3::Zero();  ///< mass centre relative to the elastic axis (x component ignored) [m]
+  /// Throws std::invalid_argument unless A, Iy, Iz, J and the shear coefficients are positive.
+  void check() const;
 };
 
 /// Thin-walled square box from outer and inner side (the paper's links 1 and 2: 0.05 m / 0.0475 m).

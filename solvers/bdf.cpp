@@ -1,7 +1,8 @@
 // SUNDIALS IDA (variable-step BDF) on y = [q_u; v_u; dissipated; input work] with our own linear
 // solver: IDA hands c_j to the Jacobian function, which assembles and factorises
 // S = c_j² M + c_j C + K; the 2N Newton system is solved through that Schur complement
-// (solvers/newton_system.hpp). Exceptions never cross IDA's C frames: every callback catches.
+// (solvers/newton_system.hpp). Exceptions never cross IDA's C frames: every callback catches, keeps
+// the message and returns a failure flag; the run's status then carries that message.
 #include <ida/ida.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_linearsolver.h>
@@ -9,10 +10,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <algorithm>
 #include <cstdlib>
 #include <stdexcept>
 
-#include "solvers/integrator.hpp"
+#include "rfem/solvers/integrator.hpp"
+#include "rfem/solvers/sundials_impl.hpp"
 
 namespace rfem {
 
@@ -20,21 +23,31 @@ namespace {
 
 struct Bdf {
   EquationsOfMotion& eq;
+  SampleEmitter& emit;
   double cj_factor = 0.0;
-  VecX r;  // residual scratch (unknowns)
+  VecX r;               // residual scratch (unknowns)
+  void* ida = nullptr;  // for the heartbeat's step count
+  std::string error;    // what a callback caught (IDA itself only sees a flag)
+  int caught(const std::exception& e) {
+    if (error.empty()) error = e.what();
+    return -1;  // unrecoverable
+  }
 };
 
 int residual(sunrealtype t, N_Vector yv, N_Vector ypv, N_Vector rv, void* data) {
   auto& p = *static_cast<Bdf*>(data);
   if (p.eq.stop_requested()) return -1;  // unrecoverable: the caller reports the interruption
+  long steps = 0;
+  if (p.ida) IDAGetNumSteps(p.ida, &steps);
+  if (!p.emit.beat(t, steps)) return -1;  // (the caller reports the heartbeat's failure)
   const double *y = N_VGetArrayPointer(yv), *yp = N_VGetArrayPointer(ypv);
   double* r = N_VGetArrayPointer(rv);
   const int u = p.eq.unknowns();
   Power P;
   try {
     P = p.eq.residual(t, y, y + u, yp + u, r + u);
-  } catch (const std::exception&) {
-    return -1;
+  } catch (const std::exception& e) {
+    return p.caught(e);
   }
   for (int i = 0; i < u; ++i) r[i] = yp[i] - y[u + i];
   r[2 * u] = yp[2 * u] - P.dissipation;
@@ -52,8 +65,8 @@ int jacobian(sunrealtype t, sunrealtype cj, N_Vector yv, N_Vector, N_Vector, SUN
     const double* y = N_VGetArrayPointer(yv);
     p.cj_factor = cj;
     return p.eq.setup_newton(t, y, y + p.eq.unknowns(), 1.0 / cj) ? 0 : 1;
-  } catch (const std::exception&) {
-    return -1;
+  } catch (const std::exception& e) {
+    return p.caught(e);
   }
 }
 
@@ -63,9 +76,9 @@ int ls_solve(SUNLinearSolver ls, SUNMatrix, N_Vector xv, N_Vector bv, sunrealtyp
   double* x = N_VGetArrayPointer(xv);
   const int u = p.eq.unknowns();
   try {
-    p.eq.newton().solve_bdf(b, x);
-  } catch (const std::exception&) {
-    return -1;
+    p.eq.solve_newton_bdf(b, x);
+  } catch (const std::exception& e) {
+    return p.caught(e);
   }
   // Energy integrals: their coupling to y is left out (a modified Newton step for them).
   x[2 * u] = b[2 * u] / p.cj_factor;
@@ -86,7 +99,7 @@ int mat_zero(SUNMatrix) { return 0; }
 void mat_destroy(SUNMatrix A) { SUNMatFreeEmpty(A); }
 
 struct IdaHandles {
-  SUNContext ctx = nullptr;
+  sundials::Context ctx;
   void* ida = nullptr;
   N_Vector y = nullptr, yp = nullptr;
   SUNMatrix A = nullptr;
@@ -97,7 +110,6 @@ struct IdaHandles {
     if (A) SUNMatDestroy(A);
     if (y) N_VDestroy(y);
     if (yp) N_VDestroy(yp);
-    if (ctx) SUNContext_Free(&ctx);
   }
 };
 
@@ -115,34 +127,46 @@ void check(int flag, const char* what) {
 
 }  // namespace
 
-RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, const SampleSink& sink) {
-  Bdf p{eq, 0.0, VecX()};
+RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, SampleEmitter& emit) {
+  Bdf p{eq, emit, 0.0, VecX(), nullptr, {}};
   const int u = eq.unknowns(), N = 2 * u + 2;
-  const long n_out = std::lround(std::ceil(opts.t_end / opts.output_dt - 1e-9));
+  const long n_out = output_count(opts);
   RunOutcome out;
 
   VecX y0 = VecX::Zero(N), yp0 = VecX::Zero(N), qu, vu;
-  eq.initial_state(qu, vu, opts.initial == InitialState::Static);
-  y0.head(u) = qu;
-  y0.segment(u, u) = vu;
-  const VecX a0 = eq.accelerations(0.0, qu.data(), vu.data());
-  yp0.head(u) = vu;
-  yp0.segment(u, u) = a0;
-  p.r.resize(u);
-  const Power P0 = eq.residual(0.0, qu.data(), vu.data(), a0.data(), p.r.data());
-  yp0[2 * u] = P0.dissipation;
-  yp0[2 * u + 1] = P0.input;
-  sink(eq.sample(0.0, qu.data(), vu.data(), a0.data(), 0.0, 0.0));
+  try {  // the start can fail like any step: a status, not an exception
+    eq.initial_state(qu, vu, opts.initial == InitialState::Static);
+    y0.head(u) = qu;
+    y0.segment(u, u) = vu;
+    const VecX a0 = eq.accelerations(0.0, qu.data(), vu.data());
+    yp0.head(u) = vu;
+    yp0.segment(u, u) = a0;
+    p.r.resize(u);
+    const Power P0 = eq.residual(0.0, qu.data(), vu.data(), a0.data(), p.r.data());
+    yp0[2 * u] = P0.dissipation;
+    yp0[2 * u + 1] = P0.input;
+    if (!y0.allFinite() || !yp0.allFinite()) throw std::runtime_error("the initial state is not finite (check the inputs' values)");
+    if (!emit(eq.sample(0.0, qu.data(), vu.data(), a0.data(), 0.0, 0.0))) {
+      out.status = emit.failure();
+      return out;
+    }
+  } catch (const std::exception& e) {
+    out.status = RunStatus::failed(std::string(e.what()) + " at the start (t = 0)");
+    return out;
+  }
 
   IdaHandles h;
-  check(SUNContext_Create(nullptr, &h.ctx), "SUNContext_Create");
-  h.y = N_VNew_Serial(N, h.ctx);
-  h.yp = N_VNew_Serial(N, h.ctx);
+  h.y = N_VNew_Serial(N, h.ctx.get());
+  h.yp = N_VNew_Serial(N, h.ctx.get());
+  if (!h.y || !h.yp) throw std::runtime_error("N_VNew_Serial failed");
   std::copy(y0.data(), y0.data() + N, N_VGetArrayPointer(h.y));
   std::copy(yp0.data(), yp0.data() + N, N_VGetArrayPointer(h.yp));
-  h.ida = IDACreate(h.ctx);
+  h.ida = IDACreate(h.ctx.get());
+  if (!h.ida) throw std::runtime_error("IDACreate failed");
+  p.ida = h.ida;
   check(IDAInit(h.ida, residual, 0.0, h.y, h.yp), "IDAInit");
-  N_Vector abstol = N_VNew_Serial(N, h.ctx);
+  N_Vector abstol = N_VNew_Serial(N, h.ctx.get());
+  if (!abstol) throw std::runtime_error("N_VNew_Serial failed");
   double* at = N_VGetArrayPointer(abstol);
   for (int i = 0; i < u; ++i) {
     at[i] = opts.atol;
@@ -153,17 +177,17 @@ RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, c
   N_VDestroy(abstol);
   check(tol_flag, "IDASVtolerances");
   check(IDASetUserData(h.ida, &p), "IDASetUserData");
-  // IDA's own messages are silenced: failures are reported once, with advice, in RunOutcome.
-  check(IDASetErrHandlerFn(h.ida, [](int, const char*, const char*, char*, void*) {}, nullptr), "IDASetErrHandlerFn");
+  check(sundials::silence_ida(h.ida, h.ctx), "silencing IDA");
   check(IDASetMaxNumSteps(h.ida, opts.max_steps), "IDASetMaxNumSteps");
   if (opts.max_step > 0) check(IDASetMaxStep(h.ida, opts.max_step), "IDASetMaxStep");
   check(IDASetMaxOrd(h.ida, opts.max_order), "IDASetMaxOrd");
   check(IDASetStopTime(h.ida, opts.t_end), "IDASetStopTime");  // tabulated inputs end at t_end
-  h.A = SUNMatNewEmpty(h.ctx);
+  h.A = SUNMatNewEmpty(h.ctx.get());
+  h.ls = SUNLinSolNewEmpty(h.ctx.get());
+  if (!h.A || !h.ls) throw std::runtime_error("SUNMatNewEmpty / SUNLinSolNewEmpty failed");
   h.A->ops->getid = mat_id;
   h.A->ops->zero = mat_zero;
   h.A->ops->destroy = mat_destroy;
-  h.ls = SUNLinSolNewEmpty(h.ctx);
   h.ls->content = &p;
   h.ls->ops->gettype = ls_type;
   h.ls->ops->setup = ls_setup;
@@ -182,34 +206,50 @@ RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, c
     IDAGetLastStep(h.ida, &out.stats.last_step);
   };
   for (long k = 1; k <= n_out; ++k) {
-    const double tout = std::min(opts.t_end, k * opts.output_dt);
+    const double tout = output_time(opts, k);
     sunrealtype tret = 0.0;
     const int flag = IDASolve(h.ida, tout, &tret, h.y, h.yp, IDA_NORMAL);
     stats();
     if (eq.stop_requested()) {
-      out.status = "interrupted (signal " + std::to_string(eq.stop_signal()) + ")";
+      out.status = RunStatus::interrupted(eq.stop().signal());
       return out;
     }
+    if (emit.failed()) {  // the heartbeat failed inside IDA
+      out.status = emit.failure();
+      return out;
+    }
+    double tcur = 0.0;
+    IDAGetCurrentTime(h.ida, &tcur);
+    char buf[160];
+    std::snprintf(buf, sizeof buf, " at t = %.6g s (last step %.3g s)", tcur, out.stats.last_step);
     if (flag < 0) {
-      double tcur = 0.0;
-      IDAGetCurrentTime(h.ida, &tcur);
-      char buf[160];
-      std::snprintf(buf, sizeof buf, " at t = %.6g s (last step %.3g s)", tcur, out.stats.last_step);
-      out.status = "failed: IDA " + flag_name(flag) + buf +
-                   "; try looser tolerances, a smaller max_step, or check the inputs";
+      out.status = RunStatus::failed((p.error.empty() ? "IDA " + flag_name(flag) : p.error) + buf +
+                                     "; try looser tolerances, a smaller max_step, or check the inputs");
       return out;
     }
     const double* y = N_VGetArrayPointer(h.y);
+    if (!std::all_of(y, y + N, [](double x) { return std::isfinite(x); })) {
+      out.status = RunStatus::failed(std::string("the solution is not finite") + buf + "; check the inputs");
+      return out;
+    }
     // Accelerations from the equations at the output state (IDA's interpolated y' is only first
     // order under BDF2).
-    OutputSample smp = eq.sample(tret, y, y + u, nullptr, y[2 * u], y[2 * u + 1]);
+    OutputSample smp;
+    try {
+      smp = eq.sample(tret, y, y + u, nullptr, y[2 * u], y[2 * u + 1]);
+    } catch (const std::exception& e) {
+      out.status = RunStatus::failed(e.what() + std::string(buf));
+      return out;
+    }
     smp.steps = out.stats.steps;
     smp.last_step = out.stats.last_step;
-    sink(smp);
+    if (!emit(smp)) {
+      out.status = emit.failure();
+      return out;
+    }
     out.t_reached = tret;
   }
-  out.completed = true;
-  out.status = "completed";
+  out.status = RunStatus::completed();
   return out;
 }
 

@@ -1,4 +1,4 @@
-#include "solvers/beam_theory.hpp"
+#include "rfem/solvers/beam_theory.hpp"
 
 #include <cmath>
 

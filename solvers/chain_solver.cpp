@@ -1,9 +1,11 @@
-#include "solvers/chain_solver.hpp"
+#include "rfem/solvers/chain_solver.hpp"
 
 #include <omp.h>
 
 #include <stdexcept>
 #include <type_traits>
+
+#include "rfem/core/check.hpp"
 
 namespace rfem {
 
@@ -13,10 +15,13 @@ using Block = Eigen::Map<RowMat6>;
 using CBlock = Eigen::Map<const RowMat6>;
 }  // namespace
 
-ChainSolver::ChainSolver(const BorderedPattern& pattern)
-    : pattern_(pattern), nb_(pattern.n_base()), nc_(static_cast<int>(pattern.chains().size())) {
+ChainSolver::ChainSolver(std::shared_ptr<const BorderedPattern> pattern)
+    : shared_(pattern ? std::move(pattern) : throw std::invalid_argument("ChainSolver: no pattern")),
+      pattern_(*shared_),
+      nb_(pattern_.n_base()),
+      nc_(static_cast<int>(pattern_.chains().size())) {
   for (int c = 0; c < nc_; ++c) {
-    const BorderedPattern::Chain& ch = pattern.chains()[c];
+    const BorderedPattern::Chain& ch = pattern_.chains()[c];
     const int half = ch.count / 2, p = ch.first + half, last = ch.first + ch.count - 1;
     sweeps_.push_back({c, ch.first, half, 1, p});            // blocks first … p−1
     sweeps_.push_back({c, last, ch.count - 1 - half, -1, p});  // blocks last … p+1
@@ -122,6 +127,7 @@ bool ChainSolver::sweep_factor_w(double* v, const Sweep& s, MatX& schur) const {
 }
 
 bool ChainSolver::factorize(std::vector<double>& values) {
+  RFEM_CHECK_ARGUMENT_SIZE(values.size(), pattern_.nnz(), "values");
   values_ = nullptr;
   double* v = values.data();
   const int off = 6 * nc_, size = off + nb_;
@@ -206,6 +212,7 @@ void ChainSolver::sweep_backward_w(const Sweep& s, VecX& b, const VecX& x_iface)
 }
 
 void ChainSolver::solve(VecX& b) const {
+  RFEM_CHECK_ARGUMENT_SIZE(b.size(), pattern_.size(), "b");
   const int n6 = 6 * pattern_.n_blocks(), off = 6 * nc_, size = off + nb_;
   if (size == 0) return;
   if (!values_) throw std::logic_error("ChainSolver::solve without a successful factorisation");

@@ -13,15 +13,17 @@
 // Per sweep block k with coupling P_k = S(previous, k):
 //   U_k = chol(D_k − Fᵀ_k F_k),  F_k = U_{k−1}⁻ᵀ P_k,  W_k = U_k⁻ᵀ (B_k − F_kᵀ W_{k−1}),
 // and the interface receives Σ W_kᵀ W_k (border) and the last block's coupling to p_c.
+#include <memory>
 #include <vector>
 
-#include "solvers/linear_solver.hpp"
+#include "rfem/solvers/linear_solver.hpp"
 
 namespace rfem {
 
 class ChainSolver : public LinearSolver {
  public:
-  explicit ChainSolver(const BorderedPattern& pattern);
+  /// Throws std::invalid_argument for a null pattern.
+  explicit ChainSolver(std::shared_ptr<const BorderedPattern> pattern);
   /// Factorises in place: `values` then holds the factor and must stay untouched until the next
   /// factorisation. Returns false if the matrix is not positive definite.
   bool factorize(std::vector<double>& values) override;
@@ -56,7 +58,8 @@ class ChainSolver : public LinearSolver {
   // The chain's part of the interface vector x (separator, then columns).
   VecX gather(int c, const VecX& x) const;
 
-  const BorderedPattern& pattern_;
+  std::shared_ptr<const BorderedPattern> shared_;
+  const BorderedPattern& pattern_;  // *shared_
   int nb_, nc_;  // border width, chains
   std::vector<Sweep> sweeps_;  // two per chain: towards the separator from either end
   Eigen::LLT<MatX> iface_;

@@ -1,13 +1,16 @@
-#include "solvers/cholmod_solver.hpp"
+#include "rfem/solvers/cholmod_solver.hpp"
 
 #include <cholmod.h>
 
 #include <algorithm>
 #include <stdexcept>
 
+#include "rfem/core/check.hpp"
+
 namespace rfem {
 
-CholmodSolver::CholmodSolver(const BorderedPattern& pattern) : pattern_(pattern) {
+CholmodSolver::CholmodSolver(std::shared_ptr<const BorderedPattern> pattern)
+    : shared_(pattern ? std::move(pattern) : throw std::invalid_argument("CholmodSolver: no pattern")), pattern_(*shared_) {
   common_ = new cholmod_common;
   cholmod_l_start(common_);
   common_->supernodal = CHOLMOD_SIMPLICIAL;
@@ -20,8 +23,8 @@ CholmodSolver::CholmodSolver(const BorderedPattern& pattern) : pattern_(pattern)
   // A views the pattern's compressed columns and, at each factorisation, the values gathered into them.
   static_assert(sizeof(SuiteSparse_long) == sizeof(long));
   A_ = new cholmod_sparse{};
-  A_->nrow = A_->ncol = static_cast<size_t>(pattern.size());
-  const auto& z = pattern.csc();
+  A_->nrow = A_->ncol = static_cast<size_t>(pattern_.size());
+  const auto& z = pattern_.csc();
   A_->nzmax = z.rowind.size();
   A_->p = const_cast<long*>(z.colptr.data());
   A_->i = const_cast<long*>(z.rowind.data());
@@ -44,6 +47,7 @@ CholmodSolver::~CholmodSolver() {
 }
 
 bool CholmodSolver::factorize(std::vector<double>& values) {
+  RFEM_CHECK_ARGUMENT_SIZE(values.size(), pattern_.nnz(), "values");
   const auto& z = pattern_.csc();
   x_.resize(z.slot.size());
   for (size_t p = 0; p < x_.size(); ++p) x_[p] = values[z.slot[p]];
@@ -60,6 +64,7 @@ bool CholmodSolver::factorize(std::vector<double>& values) {
 }
 
 void CholmodSolver::solve(VecX& b) const {
+  RFEM_CHECK_ARGUMENT_SIZE(b.size(), pattern_.size(), "b");
   const long N = pattern_.size();
   cholmod_dense B;
   B.nrow = N;

@@ -2,9 +2,10 @@
 // CHOLMOD on the bordered pattern, in phases: analyse the pattern once (natural ordering: the
 // pattern has no fill), refactorise numerically whenever values change, solve. Simplicial LDLᵀ
 // (supernodes are tiny on this pattern; see shared/TOOLCHAIN.md).
+#include <memory>
 #include <vector>
 
-#include "solvers/linear_solver.hpp"
+#include "rfem/solvers/linear_solver.hpp"
 
 struct cholmod_common_struct;
 struct cholmod_sparse_struct;
@@ -14,10 +15,9 @@ namespace rfem {
 
 class CholmodSolver : public LinearSolver {
  public:
-  explicit CholmodSolver(const BorderedPattern& pattern);
-  ~CholmodSolver();
-  CholmodSolver(const CholmodSolver&) = delete;
-  CholmodSolver& operator=(const CholmodSolver&) = delete;
+  /// Throws std::invalid_argument for a null pattern, std::runtime_error if CHOLMOD fails.
+  explicit CholmodSolver(std::shared_ptr<const BorderedPattern> pattern);
+  ~CholmodSolver() override;
 
   /// Refactorises with new values (pattern order). Returns false if the matrix is not positive
   /// definite (the caller may cut the step); the failing column is in failed_column().
@@ -27,7 +27,8 @@ class CholmodSolver : public LinearSolver {
   long failed_column() const { return failed_column_; }
 
  private:
-  const BorderedPattern& pattern_;
+  std::shared_ptr<const BorderedPattern> shared_;
+  const BorderedPattern& pattern_;  // *shared_
   cholmod_common_struct* common_ = nullptr;
   cholmod_sparse_struct* A_ = nullptr;
   cholmod_factor_struct* L_ = nullptr;

@@ -1,4 +1,4 @@
-#include "solvers/equations.hpp"
+#include "rfem/solvers/equations.hpp"
 
 #include <omp.h>
 
@@ -9,26 +9,38 @@
 #include <stdexcept>
 #include <string>
 
-#include "solvers/mass_solve.hpp"
-#include "solvers/statics.hpp"
+#include "rfem/core/check.hpp"
+#include "rfem/solvers/mass_solve.hpp"
+#include "rfem/solvers/statics.hpp"
 
 namespace rfem {
 
-EquationsOfMotion::EquationsOfMotion(const Model& model, const std::vector<JointInput>& inputs,
-                                     const ForceTerms& terms, const std::atomic<int>* stop, LinearSolverKind solver,
+namespace {
+const Model& checked(const std::shared_ptr<const Model>& m) {
+  if (!m) throw std::invalid_argument("EquationsOfMotion: no model");
+  return *m;
+}
+}  // namespace
+
+EquationsOfMotion::EquationsOfMotion(std::shared_ptr<const Model> model_ptr, std::vector<JointInput> inputs_in,
+                                     const ForceTerms& terms, StopToken stop, LinearSolverKind solver,
                                      const Parallelism& parallel, bool keep_stiffness)
-    : model_(model),
-      inputs_(inputs),
-      stop_(stop),
+    : model_(std::move(model_ptr)),
+      inputs_(std::move(inputs_in)),
+      stop_(std::move(stop)),
       terms_(terms),
-      governor_(model.n() >= parallel.min_rfes ? (parallel.threads > 0 ? parallel.threads : omp_get_max_threads()) : 1,
-                parallel.threads > 0),
-      damped_(model.sdes_damped() ||
-              std::any_of(model.joints.begin(), model.joints.end(),
+      governor_(checked(model_).n() >= parallel.min_rfes ? parallel.max_threads() : 1, parallel.threads > 0),
+      damped_(model_->sdes_damped() ||
+              std::any_of(model_->joints.begin(), model_->joints.end(),
                           [](const Joint& j) { return j.drive.damping > 0 || j.drive.friction > 0; })) {
+  const Model& model = *model_;
+  const std::vector<JointInput>& inputs = inputs_;
   ws_.parallel = parallel;
   ws_.parallel.threads = governor_.threads();
-  if (static_cast<int>(inputs.size()) != model.m()) throw std::invalid_argument("one input per joint is required");
+  RFEM_CHECK_ARGUMENT_SIZE(inputs.size(), model.m(), "inputs (one per joint)");
+  for (int j = 0; j < model.m(); ++j)
+    RFEM_CHECK_ARGUMENT(inputs[j].motion || inputs[j].torque,
+                        "joint " + std::to_string(j + 1) + " has neither a motion law nor a torque law");
   const int n6 = model.flexible_dofs();
   for (int i = 0; i < n6; ++i) unknown_.push_back(i);
   base_col_.assign(model.m(), -1);
@@ -37,7 +49,7 @@ EquationsOfMotion::EquationsOfMotion(const Model& model, const std::vector<Joint
       base_col_[j] = static_cast<int>(unknown_.size());
       unknown_.push_back(model.joint_index(j));
     }
-  newton_ = std::make_unique<NewtonSystem>(model, base_col_, solver, &ws_, keep_stiffness);
+  newton_ = std::make_unique<NewtonSystem>(model_, base_col_, solver, keep_stiffness);
   std::vector<double> kp, kd;  // feedback laws stiffen and damp their joints (in column order)
   bool feedback = false;
   for (int j = 0; j < model.m(); ++j)
@@ -50,7 +62,7 @@ EquationsOfMotion::EquationsOfMotion(const Model& model, const std::vector<Joint
 }
 
 void EquationsOfMotion::expand(double t, const double* qu, const double* vu, const double* au) {
-  const int N = model_.dof(), u = unknowns();
+  const int N = model_->dof(), u = unknowns();
   q_.setZero(N);
   v_.setZero(N);
   a_.setZero(N);
@@ -59,10 +71,10 @@ void EquationsOfMotion::expand(double t, const double* qu, const double* vu, con
     v_[unknown_[i]] = vu[i];
     if (au) a_[unknown_[i]] = au[i];
   }
-  for (int j = 0; j < model_.m(); ++j)
+  for (int j = 0; j < model_->m(); ++j)
     if (inputs_[j].prescribed()) {
       const MotionSample s = inputs_[j].motion->at(t);
-      const int k = model_.joint_index(j);
+      const int k = model_->joint_index(j);
       q_[k] = s.q;
       v_[k] = s.qd;
       a_[k] = s.qdd;
@@ -70,10 +82,10 @@ void EquationsOfMotion::expand(double t, const double* qu, const double* vu, con
 }
 
 VecX EquationsOfMotion::torques(double t) const {
-  VecX tau(model_.m());
-  for (int j = 0; j < model_.m(); ++j)
-    tau[j] = inputs_[j].prescribed() ? F_[model_.joint_index(j)]
-                                     : inputs_[j].torque->at(t, q_[model_.joint_index(j)], v_[model_.joint_index(j)]);
+  VecX tau(model_->m());
+  for (int j = 0; j < model_->m(); ++j)
+    tau[j] = inputs_[j].prescribed() ? F_[model_->joint_index(j)]
+                                     : inputs_[j].torque->at(t, q_[model_->joint_index(j)], v_[model_->joint_index(j)]);
   return tau;
 }
 
@@ -81,38 +93,38 @@ Power EquationsOfMotion::residual(double t, const double* qu, const double* vu, 
   const auto start = std::chrono::steady_clock::now();
   expand(t, qu, vu, au);
   Power p;
-  generalised_forces(model_, q_, v_, a_, terms_, F_, damped_ ? &p.dissipation : nullptr, &ws_);
+  generalised_forces(*model_, q_, v_, a_, terms_, F_, damped_ ? &p.dissipation : nullptr, &ws_);
   if (!by_steps_) {
     governor_.record(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     ws_.parallel.threads = governor_.threads();
   }
   const VecX tau = torques(t);
-  const int u = unknowns(), m = model_.m();
+  const int u = unknowns(), m = model_->m();
   for (int i = 0; i < u; ++i) r[i] = F_[unknown_[i]];
   for (int j = 0; j < m; ++j)
     if (base_col_[j] >= 0) r[base_col_[j]] -= tau[j];
-  p.input = tau.dot(model_.joint_coords(v_));
+  p.input = tau.dot(model_->joint_coords(v_));
   return p;
 }
 
 Power EquationsOfMotion::power_change(double t, const double* vu, const VecX& da, double hg) {
   Power d;
   const MatX& rows = newton_->base_rows();
-  for (int j = 0; j < model_.m(); ++j) {
+  for (int j = 0; j < model_->m(); ++j) {
     if (inputs_[j].prescribed()) d.input += inputs_[j].motion->at(t).qd * rows.row(j).dot(da);
     else {  // P = τ(t, q, v) v with δv = hγ δa, δq = (hγ)² δa
       const TorqueLaw& law = *inputs_[j].torque;
       const double vj = vu[base_col_[j]], dq = hg * hg * da[base_col_[j]], dv = hg * da[base_col_[j]];
-      d.input += law.at(t, q_[model_.joint_index(j)], vj) * dv - (law.stiffness() * dq + law.damping() * dv) * vj;
+      d.input += law.at(t, q_[model_->joint_index(j)], vj) * dv - (law.stiffness() * dq + law.damping() * dv) * vj;
     }
   }
-  if (model_.sdes_damped()) {  // the Newton system keeps the sdes' C only then
+  if (model_->sdes_damped()) {  // the Newton system keeps the sdes' C only then
     VecX Cda;
     newton_->damping_times(da, Cda);
     d.dissipation = 2.0 * hg * Eigen::Map<const VecX>(vu, unknowns()).dot(Cda);
   }
-  for (int j = 0; j < model_.m(); ++j)  // the drives' power, not a quadratic form when they have friction
-    if (base_col_[j] >= 0) d.dissipation += model_.joints[j].drive.power_derivative(vu[base_col_[j]]) * hg * da[base_col_[j]];
+  for (int j = 0; j < model_->m(); ++j)  // the drives' power, not a quadratic form when they have friction
+    if (base_col_[j] >= 0) d.dissipation += model_->joints[j].drive.power_derivative(vu[base_col_[j]]) * hg * da[base_col_[j]];
   return d;
 }
 
@@ -121,7 +133,7 @@ VecX EquationsOfMotion::accelerations(double t, const double* qu, const double* 
   VecX rhs(u);
   residual(t, qu, vu, nullptr, rhs.data());
   rhs = -rhs;
-  if (!solve_mass(model_, newton_->pattern(), base_col_, q_, v_, rhs, mass_values_))
+  if (!solve_mass(*model_, newton_->pattern(), base_col_, q_, v_, rhs, mass_values_))
     throw std::runtime_error("the mass matrix is not positive definite at t = " + std::to_string(t) + " s");
   std::vector<double>().swap(mass_values_);  // needed once or at output times: do not keep it
   return rhs;
@@ -133,8 +145,8 @@ OutputSample EquationsOfMotion::sample(double t, const double* qu, const double*
                     : (unknowns() > 0 ? accelerations(t, qu, vu) : VecX());
   VecX r(unknowns());
   residual(t, qu, vu, a.data(), r.data());  // F at these accelerations: the required torques
-  if (model_.free_base) {
-    const double pitch = q_[model_.joint_index(free_base_pitch)];
+  if (model_->free_base) {
+    const double pitch = q_[model_->joint_index(free_base_pitch)];
     if (std::abs(pitch) > free_base_pitch_limit) {
       char buf[200];
       std::snprintf(buf, sizeof buf,
@@ -150,8 +162,8 @@ OutputSample EquationsOfMotion::sample(double t, const double* qu, const double*
   s.v = v_;
   s.a = a_;
   s.tau = torques(t);
-  s.energy = energies(model_, q_, v_, &ws_);
-  s.momentum = momentum(model_, q_, v_, &ws_);
+  s.energy = energies(*model_, q_, v_, &ws_);
+  s.momentum = momentum(*model_, q_, v_, &ws_);
   s.dissipated = dissipated;
   s.input_work = input_work;
   return s;
@@ -165,7 +177,7 @@ void EquationsOfMotion::report_step(double seconds, long residuals) {
 
 bool EquationsOfMotion::setup_newton(double t, const double* qu, const double* vu, double h) {
   expand(t, qu, vu, nullptr);
-  return newton_->setup(q_, v_, h);
+  return newton_->setup(q_, v_, h, ws_);
 }
 
 std::vector<double> EquationsOfMotion::breakpoints(double t_end) const {
@@ -181,20 +193,20 @@ std::vector<double> EquationsOfMotion::breakpoints(double t_end) const {
 void EquationsOfMotion::initial_state(VecX& qu, VecX& vu, bool static_equilibrium) const {
   qu = VecX::Zero(unknowns());
   vu = VecX::Zero(unknowns());
-  for (int j = 0; j < model_.m(); ++j)
+  for (int j = 0; j < model_->m(); ++j)
     if (base_col_[j] >= 0) {
       qu[base_col_[j]] = inputs_[j].q0;
       vu[base_col_[j]] = inputs_[j].v0;
     }
-  if (!static_equilibrium || model_.n() == 0) return;
-  VecX qb(model_.m()), vb(model_.m());
-  for (int j = 0; j < model_.m(); ++j) {
+  if (!static_equilibrium || model_->n() == 0) return;
+  VecX qb(model_->m()), vb(model_->m());
+  for (int j = 0; j < model_->m(); ++j) {
     const bool law = inputs_[j].prescribed();
     qb[j] = law ? inputs_[j].motion->at(0.0).q : inputs_[j].q0;
     vb[j] = law ? inputs_[j].motion->at(0.0).qd : inputs_[j].v0;
   }
-  const StaticResult eq = solve_static(model_, qb, vb, TipLoads{});
-  qu.head(model_.flexible_dofs()) = eq.q.head(model_.flexible_dofs());
+  const StaticResult eq = solve_static(*model_, qb, vb, TipLoads{});
+  qu.head(model_->flexible_dofs()) = eq.q.head(model_->flexible_dofs());
 }
 
 }  // namespace rfem

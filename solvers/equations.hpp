@@ -4,15 +4,17 @@
 // laws of prescribed joints,
 //   r_u(t, q_u, v_u, a_u) = F_u(q, v, a) − τ_u(t),   F = M(q) a + h(q, v) + f_el + f_g + f_d,
 // and the required torques of prescribed joints are the base rows of F (inverse dynamics).
-// Shared by every time integrator; owns the Newton system on the unknowns' bordered pattern.
-#include <atomic>
+// Shared by every time integrator; owns the Newton system on the unknowns' bordered pattern and
+// the workspace of its kernels, shares the model and keeps its own copy of the inputs (their laws
+// are shared). Movable, not copyable.
 #include <memory>
 
-#include "assembly/assemble.hpp"
-#include "assembly/momentum.hpp"
-#include "solvers/inputs.hpp"
-#include "solvers/newton_system.hpp"
-#include "solvers/thread_governor.hpp"
+#include "rfem/assembly/assemble.hpp"
+#include "rfem/assembly/momentum.hpp"
+#include "rfem/solvers/inputs.hpp"
+#include "rfem/solvers/newton_system.hpp"
+#include "rfem/solvers/run_status.hpp"
+#include "rfem/solvers/thread_governor.hpp"
 
 namespace rfem {
 
@@ -26,6 +28,8 @@ struct OutputSample {
   double dissipated = 0.0, input_work = 0.0;  ///< integrals since t = 0 [J]
   long steps = 0;        ///< integrator steps taken so far (for progress reports)
   double last_step = 0;  ///< the integrator's last step size [s]
+  /// T + V + dissipated − input work [J]: constant when the energy books balance (docs/formulation.md §7).
+  double energy_balance() const { return energy.kinetic + energy.elastic + energy.gravity + dissipated - input_work; }
 };
 
 /// Power flows of one state: what the energy integrals integrate.
@@ -36,18 +40,24 @@ struct Power {
 
 class EquationsOfMotion {
  public:
-  EquationsOfMotion(const Model& model, const std::vector<JointInput>& inputs, const ForceTerms& terms,
-                    const std::atomic<int>* stop, LinearSolverKind solver = LinearSolverKind::Chain,
+  /// One input per joint; throws std::invalid_argument otherwise (or for a null model, a null law).
+  EquationsOfMotion(std::shared_ptr<const Model> model, std::vector<JointInput> inputs, const ForceTerms& terms,
+                    StopToken stop = {}, LinearSolverKind solver = LinearSolverKind::Chain,
                     const Parallelism& parallel = {}, bool keep_stiffness = false);
-  const Model& model() const { return model_; }
+  EquationsOfMotion(EquationsOfMotion&&) = default;
+  EquationsOfMotion& operator=(EquationsOfMotion&&) = default;
+  EquationsOfMotion(const EquationsOfMotion&) = delete;
+  EquationsOfMotion& operator=(const EquationsOfMotion&) = delete;
+  const Model& model() const { return *model_; }
+  const std::vector<JointInput>& inputs() const { return inputs_; }
   /// Number of unknown coordinates (size of q_u).
   int unknowns() const { return static_cast<int>(unknown_.size()); }
   /// Full coordinate index of unknown i.
   int unknown_index(int i) const { return unknown_[i]; }
   /// Joint j's column among the unknowns, −1 if prescribed.
   const std::vector<int>& base_col() const { return base_col_; }
-  bool stop_requested() const { return stop_ && stop_->load(); }
-  int stop_signal() const { return stop_ ? stop_->load() : 0; }
+  bool stop_requested() const { return stop_.requested(); }
+  const StopToken& stop() const { return stop_; }
 
   /// Full q, v, a at t from the unknowns and the prescribed laws (a_u = 0 if `au` is null).
   void expand(double t, const double* qu, const double* vu, const double* au);
@@ -73,6 +83,10 @@ class EquationsOfMotion {
   void initial_state(VecX& qu, VecX& vu, bool static_equilibrium = false) const;
 
   NewtonSystem& newton() { return *newton_; }
+  /// Solves with the Newton matrix of the last setup_newton (in place), on the kernels' team.
+  void solve_newton(VecX& b) const { newton_->solve(b, ws_.parallel.team(model_->n())); }
+  /// IDA's 2N system with that matrix (solvers/newton_system.hpp).
+  void solve_newton_bdf(const double* b, double* x) const { newton_->solve_bdf(b, x, ws_.parallel.team(model_->n())); }
   /// The thread policy of every kernel the equations run (results do not depend on it). With
   /// threads = 0 a ThreadGovernor picks one thread or all by timing the residual evaluations.
   const Parallelism& parallelism() const { return ws_.parallel; }
@@ -87,9 +101,9 @@ class EquationsOfMotion {
   VecX torques(double t) const;
 
  private:
-  const Model& model_;
-  const std::vector<JointInput>& inputs_;
-  const std::atomic<int>* stop_;
+  std::shared_ptr<const Model> model_;
+  std::vector<JointInput> inputs_;
+  StopToken stop_;
   ForceTerms terms_;
   Workspace ws_;
   ThreadGovernor governor_;

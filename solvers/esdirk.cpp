@@ -24,7 +24,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "solvers/integrator.hpp"
+#include "rfem/solvers/integrator.hpp"
 
 namespace rfem {
 
@@ -133,20 +133,43 @@ constexpr double kSafety = 0.9, kMinFactor = 0.2, kMaxFactor = 5.0;
 
 void check_esdirk_table(const std::string& name) { load_tableau(name); }
 
-RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, const SampleSink& sink) {
+RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, SampleEmitter& emit) {
   const Tableau T = load_tableau(o.esdirk_table);
   const int u = eq.unknowns(), s = T.s;
   RunOutcome out;
   IntegratorStats& st = out.stats;
 
-  VecX q, v;
-  eq.initial_state(q, v, o.initial == InitialState::Static);
-  VecX a = eq.accelerations(0.0, q.data(), v.data());
-  VecX r(u);
-  Power P = eq.residual(0.0, q.data(), v.data(), a.data(), r.data());
+  // The start (static equilibrium, initial accelerations) can fail like any step: a status, not an
+  // exception.
+  VecX q, v, a, r(u);
+  Power P;
+  try {
+    eq.initial_state(q, v, o.initial == InitialState::Static);
+    a = eq.accelerations(0.0, q.data(), v.data());
+    P = eq.residual(0.0, q.data(), v.data(), a.data(), r.data());
+  } catch (const std::exception& e) {
+    out.status = RunStatus::failed(std::string(e.what()) + " at the start (t = 0)");
+    return out;
+  }
   ++st.residual_evals;
   double Wd = 0.0, Wi = 0.0;  // dissipated energy, input work
-  sink(eq.sample(0.0, q.data(), v.data(), a.data(), 0.0, 0.0));
+  if (!q.allFinite() || !v.allFinite() || !a.allFinite()) {
+    out.status = RunStatus::failed("the initial state is not finite (check the inputs' values)");
+    return out;
+  }
+  {
+    OutputSample s0;
+    try {
+      s0 = eq.sample(0.0, q.data(), v.data(), a.data(), 0.0, 0.0);
+    } catch (const std::exception& e) {
+      out.status = RunStatus::failed(std::string(e.what()) + " at the start (t = 0)");
+      return out;
+    }
+    if (!emit(s0)) {
+      out.status = emit.failure();
+      return out;
+    }
+  }
 
   std::vector<VecX> alpha(s, VecX::Zero(u));
   std::vector<Power> Ps(s);
@@ -181,13 +204,13 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, c
   bool last_rejected = false;
   const std::vector<double> breaks = eq.breakpoints(o.t_end);
   size_t next_break = 0;
-  const long n_out = std::lround(std::ceil(o.t_end / o.output_dt - 1e-9));
-  long k_out = 1, steps_this_output = 0;
-  auto t_output = [&](long k) { return std::min(o.t_end, k * o.output_dt); };
+  const long n_out = output_count(o);
+  long k_out = 1, steps_this_output = 0, attempts_this_output = 0;
+  auto t_output = [&](long k) { return output_time(o, k); };
   auto fail = [&](const std::string& why) {
     char buf[200];
     std::snprintf(buf, sizeof buf, " at t = %.6g s (step %.3g s)", t, h);
-    out.status = "failed: " + why + buf + "; try looser tolerances, a smaller max_step, or check the inputs";
+    out.status = RunStatus::failed(why + buf + "; try looser tolerances, a smaller max_step, or check the inputs");
     out.t_reached = t;
     return out;
   };
@@ -208,12 +231,20 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, c
         }
       } timer{eq, step_start, st.residual_evals, residuals_before};
       if (eq.stop_requested()) {
-        out.status = "interrupted (signal " + std::to_string(eq.stop_signal()) + ")";
+        out.status = RunStatus::interrupted(eq.stop().signal());
+        return out;
+      }
+      if (!emit.beat(t, st.steps)) {
+        out.status = emit.failure();
         return out;
       }
       if (steps_this_output > o.max_steps)
         return fail("more than " + std::to_string(o.max_steps) + " steps in one output interval");
-      if (h < 1e-14 * std::max(1.0, t)) return fail("step size underflow");
+      // Rejected attempts count too: a step that never converges must not retry for ever.
+      if (attempts_this_output > 10 * o.max_steps + 100)
+        return fail(std::to_string(attempts_this_output) + " rejected step attempts in one output interval");
+      ++attempts_this_output;
+      if (!(h >= 1e-14 * std::max(1.0, t))) return fail(std::isfinite(h) ? "step size underflow" : "the step size is not finite");
       // Land exactly on the next breakpoint of the inputs and on t_end; stretch a step that would
       // leave a sliver.
       while (next_break < breaks.size() && breaks[next_break] <= t * (1 + 1e-14)) ++next_break;
@@ -250,7 +281,7 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, c
           ++st.residual_evals;
           ++st.newton_iters;
           if (!r.allFinite()) break;
-          eq.newton().solve(r);
+          eq.solve_newton(r);
           r = -r;  // δα
           alpha[i] += r;
           const double dn = wmax_increment(r, hg, w);
@@ -292,6 +323,14 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, c
       weights(q, v, &q1, &v1);
       const double err = std::max(wrms(eqv, evv, w), 1e-10);
       const double expo = 1.0 / (T.embedded_order + 1);
+      if (!std::isfinite(err) || !q1.allFinite() || !v1.allFinite()) {  // NaN passes no test: cut the step
+        ++st.newton_fails;
+        if (o.fixed_step > 0) return fail("the solution is not finite with the fixed step");
+        h *= 0.25;
+        eta = 1.0;
+        last_rejected = true;
+        continue;
+      }
       if (err > 1.0 && o.fixed_step <= 0) {
         ++st.error_test_fails;
         h *= std::max(kMinFactor, kSafety * std::pow(err, -expo));
@@ -312,6 +351,10 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, c
       ++steps_this_output;
       st.last_step = h;
       while (k_out <= n_out && t_output(k_out) <= t1 + 1e-12 * std::max(1.0, t1)) {
+        if (eq.stop_requested()) {  // a long step may cover many outputs
+          out.status = RunStatus::interrupted(eq.stop().signal());
+          return out;
+        }
         const double to = t_output(k_out);
         OutputSample smp;
         if (std::abs(to - t1) <= 1e-12 * std::max(1.0, t1)) {
@@ -332,10 +375,13 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, c
         }
         smp.steps = st.steps;
         smp.last_step = h;
-        sink(smp);
+        if (!emit(smp)) {
+          out.status = emit.failure();
+          return out;
+        }
         out.t_reached = to;
         ++k_out;
-        steps_this_output = 0;
+        steps_this_output = attempts_this_output = 0;
       }
       t = t1;
       q = q1;
@@ -356,8 +402,7 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, c
   } catch (const std::exception& e) {
     return fail(e.what());
   }
-  out.completed = true;
-  out.status = "completed";
+  out.status = RunStatus::completed();
   out.t_reached = o.t_end;
   return out;
 }

@@ -1,4 +1,4 @@
-#include "solvers/inputs.hpp"
+#include "rfem/solvers/inputs.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,13 +6,29 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "rfem/core/check.hpp"
+
 namespace rfem {
 
 namespace {
 
+// A table's columns: of equal length, finite.
+void check_table(const std::vector<double>& t, const std::vector<double>& v) {
+  if (t.size() != v.size())
+    throw std::invalid_argument("a table needs as many values as times (" + std::to_string(t.size()) + " times, " +
+                                std::to_string(v.size()) + " values)");
+  for (size_t i = 0; i < t.size(); ++i)
+    if (!std::isfinite(t[i]) || !std::isfinite(v[i]))
+      throw std::invalid_argument("table row " + std::to_string(i + 1) + " is not finite");
+}
+
 class Deployment : public MotionLaw {
  public:
-  Deployment(double psi0, double alpha, double T) : psi0_(psi0), k_(M_PI * alpha / (2 * T)), T_(T) {}
+  Deployment(double psi0, double alpha, double T) : psi0_(psi0), k_(M_PI * alpha / (2 * T)), T_(T) {
+    require_finite("deployment: the initial value", psi0);
+    require_finite("deployment: alpha", alpha);
+    require_positive("deployment: T", T);
+  }
   MotionSample at(double t) const override {
     if (t >= T_) return {psi0_ - k_ * T_, 0.0, 0.0};
     const double w = 2 * M_PI / T_;
@@ -26,7 +42,11 @@ class Deployment : public MotionLaw {
 
 class Spinup : public MotionLaw {
  public:
-  Spinup(double th0, double Omega, double T) : th0_(th0), W_(Omega), T_(T) {}
+  Spinup(double th0, double Omega, double T) : th0_(th0), W_(Omega), T_(T) {
+    require_finite("spinup: the initial value", th0);
+    require_finite("spinup: Omega", Omega);
+    require_positive("spinup: T", T);
+  }
   MotionSample at(double t) const override {
     if (t >= T_) return {th0_ + W_ * (t - T_ / 2), W_, 0.0};
     const double w = 2 * M_PI / T_;
@@ -41,7 +61,10 @@ class Spinup : public MotionLaw {
 
 class ConstantRate : public MotionLaw {
  public:
-  ConstantRate(double q0, double rate) : q0_(q0), rate_(rate) {}
+  ConstantRate(double q0, double rate) : q0_(q0), rate_(rate) {
+    require_finite("constant_rate: the initial value", q0);
+    require_finite("constant_rate: rate", rate);
+  }
   MotionSample at(double t) const override { return {q0_ + rate_ * t, rate_, 0.0}; }
 
  private:
@@ -52,6 +75,7 @@ class Spline : public MotionLaw {
  public:
   Spline(std::vector<double> t, std::vector<double> q) : t_(std::move(t)), q_(std::move(q)), m_(t_.size(), 0.0) {
     const size_t n = t_.size();
+    check_table(t_, q_);
     if (n < 3) throw std::invalid_argument("a tabulated motion needs at least 3 points");
     for (size_t i = 1; i < n; ++i)
       if (!(t_[i] > t_[i - 1])) throw std::invalid_argument("tabulated times must increase");
@@ -93,7 +117,7 @@ class Spline : public MotionLaw {
 
 class ConstantTorque : public TorqueLaw {
  public:
-  explicit ConstantTorque(double tau) : tau_(tau) {}
+  explicit ConstantTorque(double tau) : tau_(tau) { require_finite("torque: value", tau); }
   double at(double) const override { return tau_; }
 
  private:
@@ -103,6 +127,7 @@ class ConstantTorque : public TorqueLaw {
 class LinearTorque : public TorqueLaw {
  public:
   LinearTorque(std::vector<double> t, std::vector<double> v) : t_(std::move(t)), v_(std::move(v)) {
+    check_table(t_, v_);
     if (t_.size() < 2) throw std::invalid_argument("a tabulated torque needs at least 2 points");
     for (size_t i = 1; i < t_.size(); ++i)
       if (!(t_[i] > t_[i - 1])) throw std::invalid_argument("tabulated times must increase");
@@ -146,6 +171,8 @@ class PdTorque : public TorqueLaw {
       : ref_(std::move(ref)), ff_(std::move(ff)), kp_(kp), kd_(kd) {
     if (!ref_) throw std::invalid_argument("a PD law needs a reference motion");
     if (!(kp_ >= 0.0) || !(kd_ >= 0.0)) throw std::invalid_argument("PD gains must not be negative");
+    require_finite("pd: kp", kp_);
+    require_finite("pd: kd", kd_);
   }
   double at(double t) const override { return ff_ ? ff_->at(t) : 0.0; }
   double at(double t, double q, double v) const override {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "core/types.hpp"
+#include "rfem/core/types.hpp"
 
 namespace rfem {
 

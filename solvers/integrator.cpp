@@ -1,46 +1,90 @@
-#include "solvers/integrator.hpp"
+#include "rfem/solvers/integrator.hpp"
 
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 
+#include "rfem/core/check.hpp"
+
 namespace rfem {
 
 namespace {
 
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 // Rigid manipulator with every joint prescribed: nothing to integrate, inverse dynamics at each
 // output; the input work by Simpson's rule on each output interval (error O(Δt⁵) per interval,
 // below round-off of the balance for smooth laws; the trapezoidal rule left 1e-5 J of drift).
-RunOutcome inverse_dynamics_only(EquationsOfMotion& eq, const IntegratorOptions& opts, const SampleSink& sink) {
+RunOutcome inverse_dynamics_only(EquationsOfMotion& eq, const IntegratorOptions& opts, SampleEmitter& emit) {
   RunOutcome out;
-  const long n_out = std::lround(std::ceil(opts.t_end / opts.output_dt - 1e-9));
+  const long n_out = output_count(opts);
   auto power = [&](double t) {
     const OutputSample s = eq.sample(t, nullptr, nullptr, nullptr, 0.0, 0.0);
     return s.tau.dot(eq.model().joint_coords(s.v));
   };
   double W = 0.0, last_t = 0.0, last_P = 0.0;
-  for (long k = 0; k <= n_out; ++k) {
-    const double t = std::min(opts.t_end, k * opts.output_dt);
-    if (eq.stop_requested()) {
-      out.status = "interrupted (signal " + std::to_string(eq.stop_signal()) + ")";
-      return out;
+  try {
+    for (long k = 0; k <= n_out; ++k) {
+      const double t = output_time(opts, k);
+      if (eq.stop_requested()) {
+        out.status = RunStatus::interrupted(eq.stop().signal());
+        return out;
+      }
+      const double Pm = k > 0 ? power(0.5 * (t + last_t)) : 0.0;
+      OutputSample s = eq.sample(t, nullptr, nullptr, nullptr, 0.0, 0.0);
+      const double P = s.tau.dot(eq.model().joint_coords(s.v));
+      W += (last_P + 4.0 * Pm + P) * (t - last_t) / 6.0;
+      s.input_work = W;
+      last_t = t;
+      last_P = P;
+      if (!emit(s) || !emit.beat(t, 0)) {
+        out.status = emit.failure();
+        return out;
+      }
+      out.t_reached = t;
     }
-    const double Pm = k > 0 ? power(0.5 * (t + last_t)) : 0.0;
-    OutputSample s = eq.sample(t, nullptr, nullptr, nullptr, 0.0, 0.0);
-    const double P = s.tau.dot(eq.model().joint_coords(s.v));
-    W += (last_P + 4.0 * Pm + P) * (t - last_t) / 6.0;
-    s.input_work = W;
-    last_t = t;
-    last_P = P;
-    sink(s);
-    out.t_reached = t;
+  } catch (const std::exception& e) {
+    out.status = RunStatus::failed(e.what());
+    return out;
   }
-  out.completed = true;
-  out.status = "completed";
+  out.status = RunStatus::completed();
   return out;
 }
 
 }  // namespace
+
+SampleEmitter::SampleEmitter(const SampleSink& sink, const RunControl& control)
+    : sink_(sink), control_(control), last_beat_(now_s()) {}
+
+bool SampleEmitter::operator()(const OutputSample& s) {
+  if (failed()) return false;
+  try {
+    if (sink_) sink_(s);
+  } catch (const std::exception& e) {
+    error_ = e.what();
+  } catch (...) {
+    error_ = "the output sink threw an unknown exception";
+  }
+  return !failed();
+}
+
+bool SampleEmitter::beat(double t, long steps) {
+  if (failed()) return false;
+  if (!control_.heartbeat) return true;
+  const double now = now_s();
+  if (now - last_beat_ < control_.heartbeat_interval) return true;
+  last_beat_ = now;
+  try {
+    control_.heartbeat(t, steps);
+  } catch (const std::exception& e) {
+    error_ = e.what();
+  } catch (...) {
+    error_ = "the heartbeat threw an unknown exception";
+  }
+  return !failed();
+}
 
 std::string integrator_name(IntegratorKind k) { return k == IntegratorKind::Bdf ? "bdf" : "esdirk"; }
 
@@ -51,16 +95,53 @@ bool parse_integrator(const std::string& name, IntegratorKind& k) {
   return true;
 }
 
-RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, const IntegratorOptions& opts,
-                     const SampleSink& sink, const std::atomic<int>* stop) {
-  EquationsOfMotion eq(model, inputs, opts.forces, stop, opts.linear_solver, opts.parallel,
-                       opts.kind == IntegratorKind::Bdf);  // IDA's solve needs K on its own
-  if (eq.unknowns() == 0) return inverse_dynamics_only(eq, opts, sink);
-  return opts.kind == IntegratorKind::Bdf ? integrate_bdf(eq, opts, sink) : integrate_esdirk(eq, opts, sink);
+long output_count(const IntegratorOptions& o) { return std::lround(std::ceil(o.t_end / o.output_dt - 1e-9)); }
+
+double output_time(const IntegratorOptions& o, long k) { return std::min(o.t_end, k * o.output_dt); }
+
+void check_options(const IntegratorOptions& o) {
+  require_positive("t_end", o.t_end);
+  require_positive("output_dt", o.output_dt);
+  if (o.output_dt > o.t_end) throw std::invalid_argument("output_dt must not exceed t_end");
+  if (!(o.t_end / o.output_dt <= kMaxOutputs))
+    throw std::invalid_argument("t_end / output_dt = " + std::to_string(o.t_end / o.output_dt) +
+                                " outputs is more than the 1e8 a results file can take: choose a larger output_dt");
+  require_positive("rtol", o.rtol);
+  require_positive("atol", o.atol);
+  require_positive("atol_velocity", o.atol_velocity);
+  require_positive("atol_energy", o.atol_energy);
+  require_non_negative("max_step", o.max_step);
+  require_non_negative("fixed_step", o.fixed_step);
+  if (o.max_steps < 1) throw std::invalid_argument("max_steps must be at least 1");
+  if (o.max_order < 1 || o.max_order > 5) throw std::invalid_argument("max_order must be 1 to 5");
+  if (o.kind == IntegratorKind::Esdirk) check_esdirk_table(o.esdirk_table);
 }
 
-RunEstimate estimate_run(const Model& model, const std::vector<JointInput>& inputs, const IntegratorOptions& opts,
-                         bool time) {
+RunOutcome integrate(std::shared_ptr<const Model> model, std::vector<JointInput> inputs, const IntegratorOptions& opts,
+                     const SampleSink& sink, const RunControl& control) {
+  check_options(opts);
+  EquationsOfMotion eq(std::move(model), std::move(inputs), opts.forces, control.stop, opts.linear_solver, opts.parallel,
+                       opts.kind == IntegratorKind::Bdf);  // IDA's solve needs K on its own
+  SampleEmitter emit(sink, control);
+  try {
+    if (eq.unknowns() == 0) return inverse_dynamics_only(eq, opts, emit);
+    return opts.kind == IntegratorKind::Bdf ? integrate_bdf(eq, opts, emit) : integrate_esdirk(eq, opts, emit);
+  } catch (const std::exception& e) {  // (the integrators report their own failures; this is what is left)
+    RunOutcome out;
+    out.status = RunStatus::failed(e.what());
+    return out;
+  }
+}
+
+RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, const IntegratorOptions& opts,
+                     const SampleSink& sink, const RunControl& control) {
+  // Not owned: the caller keeps the model alive for the call, which keeps nothing afterwards.
+  return integrate(std::shared_ptr<const Model>(&model, [](const Model*) {}), inputs, opts, sink, control);
+}
+
+RunEstimate estimate_run(std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs,
+                         const IntegratorOptions& opts, bool time) {
+  RFEM_CHECK_ARGUMENT(model != nullptr, "no model");
   // Peak RSS of `rfem run cases/kane_spinup.toml` grows by 2.69 kB per rfe with ESDIRK5 and the
   // chain solver (n = 20 000 → 200 000: 72 MB → 556 MB): pattern and S, mass, damping values
   // (~1.2 kB), stage and history vectors (~1 kB), rotation cache and model; by 4.80 kB with BDF
@@ -68,9 +149,9 @@ RunEstimate estimate_run(const Model& model, const std::vector<JointInput>& inpu
   // program itself.
   const double per_rfe = opts.kind == IntegratorKind::Bdf ? 4.80e3 : 2.69e3;
   RunEstimate e;
-  e.bytes = 18e6 + per_rfe * model.n();
+  e.bytes = 18e6 + per_rfe * model->n();
   if (!time) return e;
-  EquationsOfMotion eq(model, inputs, opts.forces, nullptr, opts.linear_solver, opts.parallel,
+  EquationsOfMotion eq(model, inputs, opts.forces, StopToken{}, opts.linear_solver, opts.parallel,
                        opts.kind == IntegratorKind::Bdf);
   if (eq.unknowns() == 0) return e;
   VecX q, v;

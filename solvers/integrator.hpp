@@ -10,11 +10,12 @@
 //    with an explicit first stage, order 3–5 (Kennedy & Carpenter's ESDIRK tables as shipped by
 //    SUNDIALS ARKODE), written for the implicit second-order form (solvers/esdirk.cpp);
 //  - `bdf`: SUNDIALS IDA (variable-step BDF, order ≤ max_order) with our CHOLMOD linear solver.
-#include <atomic>
 #include <functional>
+#include <memory>
 #include <string>
 
-#include "solvers/equations.hpp"
+#include "rfem/solvers/equations.hpp"
+#include "rfem/solvers/run_status.hpp"
 
 namespace rfem {
 
@@ -62,10 +63,10 @@ struct IntegratorStats {
 };
 
 struct RunOutcome {
-  bool completed = false;
-  std::string status;  ///< "completed", "interrupted (signal N)" or "failed: …"
+  RunStatus status;
   double t_reached = 0.0;
   IntegratorStats stats;
+  bool completed() const { return status.is_completed(); }
 };
 
 /// "esdirk" / "bdf" and back; parse returns false for an unknown name.
@@ -73,16 +74,40 @@ std::string integrator_name(IntegratorKind k);
 bool parse_integrator(const std::string& name, IntegratorKind& k);
 /// Throws std::invalid_argument naming what is wrong if `name` is not a usable ESDIRK table.
 void check_esdirk_table(const std::string& name);
+/// Throws std::invalid_argument naming the option that is not usable: non-positive or non-finite
+/// times and tolerances, an output interval longer than the run, more than kMaxOutputs outputs.
+void check_options(const IntegratorOptions& opts);
+/// Outputs are at t_k = output_time(opts, k), k = 0 … output_count(opts): every output_dt, the last
+/// one at t_end.
+long output_count(const IntegratorOptions& opts);
+double output_time(const IntegratorOptions& opts, long k);
+/// More outputs than this (t_end / output_dt) are refused: a results file of 10⁸ rows per series.
+inline constexpr double kMaxOutputs = 1e8;
 
 using SampleSink = std::function<void(const OutputSample&)>;
 
-/// Integrates from t = 0 (rfes undeformed and at rest) to t_end, calling `sink` at t = 0 and every
-/// output_dt. `stop` (may be null) is polled: non-zero interrupts the run cleanly.
-/// With no unknowns (rigid manipulator, all joints prescribed) it evaluates inverse dynamics only.
-RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, const IntegratorOptions& opts,
-                     const SampleSink& sink, const std::atomic<int>* stop = nullptr);
+/// How the caller steers a run while it goes: a stop token polled at every step, and a heartbeat
+/// called from the integration loop at most every `heartbeat_interval` seconds of wall time (for
+/// progress, and for a caller that must poll something of its own, e.g. Python's signals). The
+/// heartbeat runs on the calling thread; if it throws, the run fails with its message.
+struct RunControl {
+  StopToken stop;
+  std::function<void(double t, long steps)> heartbeat;
+  double heartbeat_interval = 0.2;  ///< [s]
+};
 
-/// What a run will cost, known before it starts (issue 11: a run of 200 000 rfes gave no warning).
+/// Integrates from t = 0 to t_end, calling `sink` at t = 0 and every output_dt (output_time).
+/// Shares the model and copies the inputs. With no unknowns (rigid manipulator, all joints
+/// prescribed) it evaluates inverse dynamics only. Throws std::invalid_argument for bad options or
+/// inputs that do not fit the model; every failure after the start (the integrator, the sink, the
+/// equations) ends the run with status failed and its reason, the samples so far delivered.
+RunOutcome integrate(std::shared_ptr<const Model> model, std::vector<JointInput> inputs, const IntegratorOptions& opts,
+                     const SampleSink& sink, const RunControl& control = {});
+/// The same for a model the caller keeps alive during the call.
+RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, const IntegratorOptions& opts,
+                     const SampleSink& sink, const RunControl& control = {});
+
+/// What a run will cost, known before it starts.
 struct RunEstimate {
   double bytes = 0.0;          ///< peak memory of the integration [B] (measured per rfe, see .cpp)
   double residual_s = 0.0;     ///< one residual evaluation [s], timed on this machine (0 if not timed)
@@ -95,11 +120,35 @@ struct RunEstimate {
 inline constexpr int kLargeRunRfes = 10000;
 /// The memory of a run from the model's size; with `time` also one residual evaluation and one
 /// Newton setup timed at the undeformed initial state (allocates what the run will allocate).
-RunEstimate estimate_run(const Model& model, const std::vector<JointInput>& inputs, const IntegratorOptions& opts,
-                         bool time);
+RunEstimate estimate_run(std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs,
+                         const IntegratorOptions& opts, bool time);
 
 /// The integrators behind integrate() (the equations hold the unknowns' layout and Newton system).
-RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& opts, const SampleSink& sink);
-RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, const SampleSink& sink);
+/// `emit` delivers a sample to the sink and returns false once the sink has failed (the run then
+/// ends failed; control's heartbeat is called by `beat`).
+class SampleEmitter;
+RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& opts, SampleEmitter& emit);
+RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, SampleEmitter& emit);
+
+/// Delivers samples to the caller's sink and heartbeat, catching what they throw: a failing sink
+/// or heartbeat ends the run (failed, with its message) instead of unwinding through the
+/// integrator (or IDA's C frames).
+class SampleEmitter {
+ public:
+  SampleEmitter(const SampleSink& sink, const RunControl& control);
+  /// False if the sink threw (now or before): the run must end with failure().
+  bool operator()(const OutputSample& s);
+  /// Calls the heartbeat if its interval has passed. False if it threw.
+  bool beat(double t, long steps);
+  bool failed() const { return !error_.empty(); }
+  /// The status of a run ended by the sink or heartbeat.
+  RunStatus failure() const { return RunStatus::failed(error_); }
+
+ private:
+  const SampleSink& sink_;
+  const RunControl& control_;
+  std::string error_;
+  double last_beat_ = 0.0;
+};
 
 }  // namespace rfem

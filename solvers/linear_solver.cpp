@@ -1,7 +1,7 @@
-#include "solvers/linear_solver.hpp"
+#include "rfem/solvers/linear_solver.hpp"
 
-#include "solvers/chain_solver.hpp"
-#include "solvers/cholmod_solver.hpp"
+#include "rfem/solvers/chain_solver.hpp"
+#include "rfem/solvers/cholmod_solver.hpp"
 
 namespace rfem {
 
@@ -14,9 +14,9 @@ bool parse_linear_solver(const std::string& name, LinearSolverKind& k) {
   return true;
 }
 
-std::unique_ptr<LinearSolver> make_linear_solver(LinearSolverKind k, const BorderedPattern& pattern) {
-  if (k == LinearSolverKind::Cholmod) return std::make_unique<CholmodSolver>(pattern);
-  return std::make_unique<ChainSolver>(pattern);
+std::unique_ptr<LinearSolver> make_linear_solver(LinearSolverKind k, std::shared_ptr<const BorderedPattern> pattern) {
+  if (k == LinearSolverKind::Cholmod) return std::make_unique<CholmodSolver>(std::move(pattern));
+  return std::make_unique<ChainSolver>(std::move(pattern));
 }
 
 }  // namespace rfem

@@ -1,17 +1,22 @@
 #pragma once
 // A symmetric positive definite solver on the bordered pattern, in phases: construct (analyse the
-// pattern once), factorize (new values, same pattern), solve.
+// pattern once), factorize (new values, same pattern), solve. A solver shares its pattern (the
+// pattern lives as long as any solver or system that uses it); solvers are neither copied nor moved
+// (they live behind a pointer).
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "assembly/pattern.hpp"
-#include "core/types.hpp"
+#include "rfem/assembly/pattern.hpp"
+#include "rfem/core/types.hpp"
 
 namespace rfem {
 
 class LinearSolver {
  public:
+  LinearSolver() = default;
+  LinearSolver(const LinearSolver&) = delete;
+  LinearSolver& operator=(const LinearSolver&) = delete;
   virtual ~LinearSolver() = default;
   /// Refactorises with new values (pattern order). False if not positive definite. The solver
   /// may keep and overwrite `values` (the chain solver factorises in place): they belong to it
@@ -28,6 +33,6 @@ class LinearSolver {
 enum class LinearSolverKind { Chain, Cholmod };
 std::string linear_solver_name(LinearSolverKind k);
 bool parse_linear_solver(const std::string& name, LinearSolverKind& k);
-std::unique_ptr<LinearSolver> make_linear_solver(LinearSolverKind k, const BorderedPattern& pattern);
+std::unique_ptr<LinearSolver> make_linear_solver(LinearSolverKind k, std::shared_ptr<const BorderedPattern> pattern);
 
 }  // namespace rfem

@@ -1,4 +1,4 @@
-#include "solvers/mass_solve.hpp"
+#include "rfem/solvers/mass_solve.hpp"
 
 namespace rfem {
 

@@ -1,4 +1,4 @@
-#include "solvers/modes.hpp"
+#include "rfem/solvers/modes.hpp"
 
 #include <Spectra/SymEigsShiftSolver.h>
 #include <Spectra/SymGEigsShiftSolver.h>
@@ -8,10 +8,10 @@
 
 #include <stdexcept>
 
-#include "assembly/assemble.hpp"
-#include "assembly/rfe_kernels.hpp"
-#include "solvers/cholmod_solver.hpp"
-#include "solvers/statics.hpp"
+#include "rfem/assembly/assemble.hpp"
+#include "rfem/assembly/rfe_kernels.hpp"
+#include "rfem/solvers/cholmod_solver.hpp"
+#include "rfem/solvers/statics.hpp"
 
 namespace rfem {
 
@@ -60,8 +60,8 @@ BlockMass block_mass(const Model& model, const VecX& q) {
 class ShiftInvertOp {
  public:
   using Scalar = double;
-  ShiftInvertOp(const BorderedPattern& p, const std::vector<double>& K, const BlockMass& bm)
-      : pattern_(p), K_(K), bm_(bm), solver_(p) {}
+  ShiftInvertOp(const std::shared_ptr<const BorderedPattern>& p, const std::vector<double>& K, const BlockMass& bm)
+      : pattern_(*p), K_(K), bm_(bm), solver_(p) {}
   Eigen::Index rows() const { return pattern_.size(); }
   Eigen::Index cols() const { return pattern_.size(); }
   void set_shift(double sigma) {
@@ -92,8 +92,9 @@ class ShiftInvertOp {
 class GeneralShiftInvertOp {
  public:
   using Scalar = double;
-  GeneralShiftInvertOp(const BorderedPattern& p, const std::vector<double>& K, const std::vector<double>& M)
-      : pattern_(p), K_(K), M_(M), solver_(p) {}
+  GeneralShiftInvertOp(const std::shared_ptr<const BorderedPattern>& p, const std::vector<double>& K,
+                       const std::vector<double>& M)
+      : pattern_(*p), K_(K), M_(M), solver_(p) {}
   Eigen::Index rows() const { return pattern_.size(); }
   Eigen::Index cols() const { return pattern_.size(); }
   void set_shift(double sigma) {
@@ -186,7 +187,8 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
                                     std::to_string(tau[j]) + (model.joints[j].type == JointType::Revolute ? " N m" : " N") + " in the held equilibrium: freed, it has no "
                                     "equilibrium to linearise about");
   }
-  const BorderedPattern pattern(model, cols);
+  const auto shared_pattern = std::make_shared<const BorderedPattern>(model, cols);
+  const BorderedPattern& pattern = *shared_pattern;
   const bool bordered = pattern.n_base() > 0;  // M is then not block diagonal
   MatrixTerms terms;
   terms.stiffness = 1.0;
@@ -224,14 +226,14 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
     const double scale = 1e-3 * std::abs(K[pattern.slot(6 * last, 6 * last)] / bm.M[last](0, 0));
     auto lanczos = [&](double sigma, VecX& lam, MatX& shapes) {
       if (bordered) {
-        GeneralShiftInvertOp op(pattern, K, Mv);
+        GeneralShiftInvertOp op(shared_pattern, K, Mv);
         MassProductOp bop(pattern, Mv);
         Spectra::SymGEigsShiftSolver<GeneralShiftInvertOp, MassProductOp, Spectra::GEigsMode::ShiftInvert> eigs(
             op, bop, count, ncv, sigma);
         ascending(eigs, lam, shapes);
         return;
       }
-      ShiftInvertOp op(pattern, K, bm);
+      ShiftInvertOp op(shared_pattern, K, bm);
       Spectra::SymEigsShiftSolver<ShiftInvertOp> eigs(op, count, ncv, sigma);
       MatX U;
       ascending(eigs, lam, U);

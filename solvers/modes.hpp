@@ -7,7 +7,7 @@
 // ones. Free joints without stiffness give rigid-body modes (ω = 0, kind Rigid).
 #include <string>
 
-#include "core/model.hpp"
+#include "rfem/core/model.hpp"
 
 namespace rfem {
 

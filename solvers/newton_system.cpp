@@ -1,20 +1,19 @@
-#include "solvers/newton_system.hpp"
+#include "rfem/solvers/newton_system.hpp"
 
 #include <stdexcept>
 
 namespace rfem {
 
-NewtonSystem::NewtonSystem(const Model& model, std::vector<int> base_col, LinearSolverKind kind, Workspace* ws,
+NewtonSystem::NewtonSystem(std::shared_ptr<const Model> model, std::vector<int> base_col, LinearSolverKind kind,
                            bool keep_stiffness)
-    : model_(model),
-      ws_(ws ? *ws : own_),
+    : model_(model ? std::move(model) : throw std::invalid_argument("NewtonSystem: no model")),
       base_col_(std::move(base_col)),
-      pattern_(model, base_col_),
+      pattern_(std::make_shared<const BorderedPattern>(*model_, base_col_)),
       solver_(make_linear_solver(kind, pattern_)),
-      damped_(model.sdes_damped()),
+      damped_(model_->sdes_damped()),
       keep_stiffness_(keep_stiffness) {}
 
-bool NewtonSystem::setup(const VecX& q, const VecX& v, double h) {
+bool NewtonSystem::setup(const VecX& q, const VecX& v, double h, Workspace& ws) {
   MatrixTerms terms;
   terms.mass = 1.0;
   terms.damping = h;
@@ -22,15 +21,15 @@ bool NewtonSystem::setup(const VecX& q, const VecX& v, double h) {
   std::vector<SdeTarget> extra;
   if (keep_stiffness_) extra.push_back({&K_, 1.0, 0.0});
   if (damped_) extra.push_back({&C_, 0.0, 1.0});
-  assemble_matrices(model_, pattern_, base_col_, q, v, terms, S_, extra, &base_rows_, &ws_);
-  const int nb = pattern_.n_base(), first = nb - static_cast<int>(kp_.size());  // unknown joints end the border
+  assemble_matrices(*model_, *pattern_, base_col_, q, v, terms, S_, extra, &base_rows_, &ws);
+  const int nb = pattern_->n_base(), first = nb - static_cast<int>(kp_.size());  // unknown joints end the border
   for (int c = 0; c < static_cast<int>(kp_.size()); ++c) {
-    const long d = pattern_.base() + static_cast<long>(first + c) * nb + first + c;
+    const long d = pattern_->base() + static_cast<long>(first + c) * nb + first + c;
     S_[d] += h * kd_[c] + h * h * kp_[c];
     if (keep_stiffness_) K_[d] += kp_[c];
   }
   h_ = h;
-  solver_->set_threads(ws_.parallel.team(model_.n()));
+  solver_->set_threads(ws.parallel.team(model_->n()));
   return solver_->factorize(S_);
 }
 
@@ -43,8 +42,8 @@ void NewtonSystem::set_joint_feedback(std::vector<double> kp, std::vector<double
   kd_ = std::move(kd);
 }
 
-void NewtonSystem::solve(VecX& b) const {
-  solver_->set_threads(ws_.parallel.team(model_.n()));
+void NewtonSystem::solve(VecX& b, int threads) const {
+  solver_->set_threads(threads);
   solver_->solve(b);
 }
 
@@ -53,16 +52,16 @@ void NewtonSystem::damping_times(const VecX& x, VecX& y) const {
     y.setZero(x.size());
     return;
   }
-  pattern_.multiply(C_, x, y);
+  pattern_->multiply(C_, x, y);
 }
 
-void NewtonSystem::solve_bdf(const double* b, double* x) const {
+void NewtonSystem::solve_bdf(const double* b, double* x, int threads) const {
   const int u = size();
   const double c = 1.0 / h_;
   VecX Kb1;
-  pattern_.multiply(K_, Eigen::Map<const VecX>(b, u), Kb1);
+  pattern_->multiply(K_, Eigen::Map<const VecX>(b, u), Kb1);
   VecX rhs = c * Eigen::Map<const VecX>(b + u, u) - Kb1;
-  solve(rhs);  // S(h) = h² (c² M + c C + K): x2 = S⁻¹ rhs / c²
+  solve(rhs, threads);  // S(h) = h² (c² M + c C + K): x2 = S⁻¹ rhs / c²
   rhs *= h_ * h_;
   for (int i = 0; i < u; ++i) {
     x[u + i] = rhs[i];

@@ -8,41 +8,50 @@
 // For IDA (c = c_j = 1/h) the 2N system [c I, −I; K, C + c M] [x1; x2] = [b1; b2] is solved
 // through its Schur complement: (c² M + c C + K) x2 = c b2 − K b1, x1 = (b1 + x2)/c; K is then
 // kept as well.
-#include "assembly/assemble.hpp"
-#include "solvers/linear_solver.hpp"
+//
+// The system shares its model and owns its pattern, solver and values; the caller's workspace
+// (thread policy and scratch) is an argument of setup(). Movable, not copyable.
+#include <memory>
+
+#include "rfem/assembly/assemble.hpp"
+#include "rfem/solvers/linear_solver.hpp"
 
 namespace rfem {
 
 class NewtonSystem {
  public:
   /// base_col[j]: joint j's column among the unknowns (numbered after the 6n rfe coordinates), −1
-  /// if prescribed. `ws`: the caller's workspace (thread policy and scratch of the assembly), or
-  /// null for one of its own. `keep_stiffness`: keep K (IDA's solve).
-  NewtonSystem(const Model& model, std::vector<int> base_col, LinearSolverKind kind = LinearSolverKind::Chain,
-               Workspace* ws = nullptr, bool keep_stiffness = false);
+  /// if prescribed. `keep_stiffness`: keep K (IDA's solve). Throws std::invalid_argument for a
+  /// null model or a base_col that does not fit it.
+  NewtonSystem(std::shared_ptr<const Model> model, std::vector<int> base_col,
+               LinearSolverKind kind = LinearSolverKind::Chain, bool keep_stiffness = false);
+  NewtonSystem(NewtonSystem&&) noexcept = default;
+  NewtonSystem& operator=(NewtonSystem&&) noexcept = default;
+  NewtonSystem(const NewtonSystem&) = delete;
+  NewtonSystem& operator=(const NewtonSystem&) = delete;
+
   /// Stiffness and damping a feedback law adds on the unknown joints' diagonal (one per unknown
   /// joint, in column order): S gains h kd + h² kp, IDA's K gains kp.
   void set_joint_feedback(std::vector<double> kp, std::vector<double> kd);
-  /// Assembles S(h) at a state (full coordinates) and factorises it. False if not positive definite.
-  bool setup(const VecX& q, const VecX& v, double h);
-  /// Solves S(h) x = b in place (the h of the last setup).
-  void solve(VecX& b) const;
+  /// Assembles S(h) at a state (full coordinates) with the workspace's thread policy and scratch
+  /// and factorises it. False if not positive definite.
+  bool setup(const VecX& q, const VecX& v, double h, Workspace& ws);
+  /// Solves S(h) x = b in place (the h of the last setup) on up to `threads` threads.
+  void solve(VecX& b, int threads = 1) const;
   /// IDA's system for x = [x1; x2] (2·size()) given b, with c = 1/h of the last setup.
-  void solve_bdf(const double* b, double* x) const;
+  void solve_bdf(const double* b, double* x, int threads = 1) const;
   double h() const { return h_; }
-  int size() const { return pattern_.size(); }
-  const BorderedPattern& pattern() const { return pattern_; }
+  int size() const { return pattern_->size(); }
+  const BorderedPattern& pattern() const { return *pattern_; }
   /// Rows of every joint of M over the unknowns (m × size()), at the last setup.
   const MatX& base_rows() const { return base_rows_; }
   /// y = C x with the sde damping of the last setup (zero if undamped).
   void damping_times(const VecX& x, VecX& y) const;
 
  private:
-  const Model& model_;
-  Workspace own_;
-  Workspace& ws_;
+  std::shared_ptr<const Model> model_;
   std::vector<int> base_col_;
-  BorderedPattern pattern_;
+  std::shared_ptr<const BorderedPattern> pattern_;
   std::unique_ptr<LinearSolver> solver_;
   std::vector<double> S_, K_, C_, kp_, kd_;
   MatX base_rows_;

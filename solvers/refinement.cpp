@@ -1,4 +1,4 @@
-#include "solvers/refinement.hpp"
+#include "rfem/solvers/refinement.hpp"
 
 #include <cmath>
 #include <cstdio>

@@ -1,13 +1,14 @@
-#include "solvers/statics.hpp"
+#include "rfem/solvers/statics.hpp"
 
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-#include "assembly/assemble.hpp"
-#include "core/kinematics.hpp"
-#include "core/rotation.hpp"
-#include "solvers/cholmod_solver.hpp"
+#include "rfem/assembly/assemble.hpp"
+#include "rfem/core/kinematics.hpp"
+#include "rfem/core/positions.hpp"
+#include "rfem/core/rotation.hpp"
+#include "rfem/solvers/cholmod_solver.hpp"
 
 namespace rfem {
 
@@ -22,52 +23,6 @@ Vec6 tip_generalised_force(const Model& model, int l, const Vec6& qn, const TipL
   for (int a = 0; a < 3; ++a)
     Q[3 + a] = loads.force.dot(d.dR[a] * model.links[l].d.tip_eta) + loads.moment.dot(axes[a]);
   return Q;
-}
-
-Vec6 tip_motion(const Model& model, int l, const VecX& q) {
-  const MountedLink& L = model.links[l];
-  Vec6 out = Vec6::Zero();
-  if (L.n() == 0) return out;
-  const Vec6 qn = q.segment<6>(model.rfe_index(l, L.n() - 1));
-  DeformationTransform d;
-  deformation_transform(qn, d);
-  const Vec3& eta = L.d.tip_eta;
-  out.head<3>() = qn.head<3>() + d.D.topLeftCorner<3, 3>() * eta - eta;
-  out.tail<3>() = qn.tail<3>();
-  return out;
-}
-
-namespace {
-// The point at s on link l's elastic axis, in {r}: moving with the rfe whose span holds it.
-Vec3 point_in_r(const Model& model, int l, double s, const VecX& q) {
-  const MountedLink& L = model.links[l];
-  const int k = rfe_at(L.d, s);
-  if (k < 0) return Vec3(s, 0.0, 0.0);  // rigid with {r}
-  const Vec6 qk = q.segment<6>(model.rfe_index(l, k));
-  DeformationTransform d;
-  deformation_transform(qk, d, false);
-  const Vec3 eta = Vec3(s, 0.0, 0.0) - L.d.rfes[k].centre;  // in the rfe's frame
-  return L.d.rfes[k].centre + qk.head<3>() + d.D.topLeftCorner<3, 3>() * eta;
-}
-}  // namespace
-
-Vec3 point_position(const Model& model, int l, double s, const VecX& q) {
-  BaseKinematics bk;
-  const VecX z = VecX::Zero(model.dof());
-  base_kinematics(model, q, z, z, bk);
-  const Mat4& B0 = bk.frame[l].B0;
-  return B0.topLeftCorner<3, 3>() * point_in_r(model, l, s, q) + B0.topRightCorner<3, 1>();
-}
-
-Vec3 tip_position(const Model& model, int l, const VecX& q) { return point_position(model, l, model.links[l].d.length, q); }
-
-std::vector<Vec3> joint_positions(const Model& model, const VecX& q) {
-  BaseKinematics bk;
-  const VecX z = VecX::Zero(model.dof());
-  base_kinematics(model, q, z, z, bk);
-  std::vector<Vec3> out;
-  for (int i : model.joint_node) out.push_back(bk.W[i].topRightCorner<3, 1>());
-  return out;
 }
 
 int loaded_link(const Model& model, const TipLoads& loads) {
@@ -99,7 +54,7 @@ VecX tip_load_forces(const Model& model, const VecX& q, const TipLoads& loads) {
     }
     Q.segment<6>(at) = tip_generalised_force(model, l, q.segment<6>(at), own);
   }
-  const Vec3 local = point_in_r(model, l, L.d.length, q);  // the tip in {r}
+  const Vec3 local = point_in_link_frame(model, l, L.d.length, q);  // the tip in {r}
   const Mat4& B0 = bk.frame[l].B0;
   const Vec4 p = B0 * Vec4(local[0], local[1], local[2], 1.0);
   for (int j : L.ancestors) {  // ∂p/∂q_j = (Ξ_j p)₁₋₃, ω_j = vee of Ξ_j's rotation
@@ -142,8 +97,9 @@ StaticResult solve_static(const Model& model, const VecX& qb, const VecX& vb, co
   VecX v = VecX::Zero(model.dof());
   if (vb.size()) model.joint_coords(v) = vb;
   const std::vector<int> held(m, -1);
-  const BorderedPattern pattern(model, held);
-  CholmodSolver solver(pattern);
+  const auto shared_pattern = std::make_shared<const BorderedPattern>(model, held);
+  const BorderedPattern& pattern = *shared_pattern;
+  CholmodSolver solver(shared_pattern);
   MatrixTerms terms;
   terms.stiffness = 1.0;
   terms.gravity = true;

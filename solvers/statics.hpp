@@ -3,7 +3,8 @@
 // steadily rotating base, given joint rates): f_el(q) + f_g(q) + h(q, v_b) = Q_tip(q), solved by
 // Newton iteration with the CHOLMOD factor of the stiffness (elastic with geometric term, gravity,
 // centrifugal), with load stepping when a full step does not converge.
-#include "core/model.hpp"
+#include "rfem/core/model.hpp"
+#include "rfem/core/positions.hpp"
 
 namespace rfem {
 
@@ -41,15 +42,6 @@ Vec6 tip_generalised_force(const Model& model, int l, const Vec6& qn, const TipL
 /// link's last rfe and every node that carries the link (a link on another's tip loads both).
 VecX tip_load_forces(const Model& model, const VecX& q, const TipLoads& loads);
 
-/// Link l's free end: displacement (3, in its {r}) and small rotation (3) relative to undeformed.
-Vec6 tip_motion(const Model& model, int l, const VecX& q);
-/// Position in {0} of the point at s along link l's elastic axis, moving with the rfe whose span
-/// holds it (rfe_0's span, or a rigid link: with {r}); full coordinates q.
-Vec3 point_position(const Model& model, int l, double s, const VecX& q);
-/// Position of link l's free end (on the elastic axis) in the inertial frame {0}.
-Vec3 tip_position(const Model& model, int l, const VecX& q);
-/// Origin of every joint's frame (where the body it moves is placed) in {0}.
-std::vector<Vec3> joint_positions(const Model& model, const VecX& q);
 /// The link tip loads act on (TipLoads::link, −1 for the last); throws std::invalid_argument if
 /// there is none.
 int loaded_link(const Model& model, const TipLoads& loads);

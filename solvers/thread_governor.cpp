@@ -1,4 +1,4 @@
-#include "solvers/thread_governor.hpp"
+#include "rfem/solvers/thread_governor.hpp"
 
 #include <algorithm>
 

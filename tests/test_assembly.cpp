@@ -5,10 +5,10 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
-#include "assembly/assemble.hpp"
-#include "assembly/dense_reference.hpp"
-#include "solvers/cholmod_solver.hpp"
-#include "solvers/mass_solve.hpp"
+#include "rfem/assembly/assemble.hpp"
+#include "rfem/assembly/dense_reference.hpp"
+#include "rfem/solvers/cholmod_solver.hpp"
+#include "rfem/solvers/mass_solve.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;
@@ -47,7 +47,8 @@ TEST(Assembly, SparseEqualsDenseReferenceWithOneAndTwoThreads) {
   m.joints[1].drive = {0.1, 0.0, 0.2, 0.05};
   VecX q, v, a;
   test::random_state(m, 11, q, v, a);
-  const BorderedPattern p(m.n(), m.m());
+  const auto pp = std::make_shared<const BorderedPattern>(m.n(), m.m());
+  const BorderedPattern& p = *pp;
   const MatX ref = 400.0 * dense_mass_matrix(m, q) + 20.0 * dense_damping(m, q, v) + dense_stiffness(m, q, true);
   for (int threads : {1, 2}) {
     const MatX S = to_dense(p, newton_values(m, p, q, v, threads));
@@ -93,9 +94,10 @@ TEST(Assembly, CholmodSolveEqualsDenseSolve) {
   const Model m = test::spatial_arm(9, 0.002);
   VecX q, v, a;
   test::random_state(m, 13, q, v, a);
-  const BorderedPattern p(m.n(), m.m());
+  const auto pp = std::make_shared<const BorderedPattern>(m.n(), m.m());
+  const BorderedPattern& p = *pp;
   auto vals = newton_values(m, p, q, v, 2);
-  CholmodSolver solver(p);
+  CholmodSolver solver(pp);
   ASSERT_TRUE(solver.factorize(vals));
   VecX x = a;
   solver.solve(x);
@@ -138,7 +140,8 @@ TEST(Assembly, TreeSparseEqualsDenseReferenceWithOneAndTwoThreads) {
   for (const std::vector<int>& unknown : {std::vector<int>{0, 1, 2, 3}, std::vector<int>{1, 3}}) {
     std::vector<int> cols(m.m(), -1);
     for (size_t i = 0; i < unknown.size(); ++i) cols[unknown[i]] = m.flexible_dofs() + static_cast<int>(i);
-    const BorderedPattern p(m, cols);
+    const auto pp = std::make_shared<const BorderedPattern>(m, cols);
+  const BorderedPattern& p = *pp;
     const MatX expect = unknown_part(m, cols, ref);
     std::vector<double> vals[2];
     for (int threads : {1, 2}) {
@@ -160,7 +163,8 @@ TEST(Assembly, TreeMassSolveEqualsDenseSolve) {
   test::random_state(m, 33, q, v, a);
   std::vector<int> cols(m.m(), -1);
   cols[1] = m.flexible_dofs();
-  const BorderedPattern p(m, cols);
+  const auto pp = std::make_shared<const BorderedPattern>(m, cols);
+  const BorderedPattern& p = *pp;
   const MatX M = unknown_part(m, cols, dense_mass_matrix(m, q));
   VecX b = VecX::LinSpaced(p.size(), -1.0, 1.0), x = b;
   std::vector<double> scratch;

@@ -10,9 +10,9 @@
 
 #include <cmath>
 
-#include "apps/commands.hpp"
-#include "solvers/beam_theory.hpp"
-#include "solvers/modes.hpp"
+#include "rfem/studies/quantities.hpp"
+#include "rfem/solvers/beam_theory.hpp"
+#include "rfem/solvers/modes.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;
@@ -29,7 +29,7 @@ struct Series {
 
 Series series(const Case& c, const std::string& q, std::vector<int> ns = {20, 40, 80}) {
   Series s;
-  for (int n : ns) s.v.push_back(app::evaluate_quantity(c, n, q, {}));
+  for (int n : ns) s.v.push_back(evaluate_quantity(c, n, q));
   return s;
 }
 
@@ -186,12 +186,12 @@ TEST(RotatingBeam, StaticStretchOfASpinningBar) {
   const double exact = std::tan(k * L) / k - L;
   std::vector<double> u;
   for (int n : {10, 20, 40}) {
-    app::ModesOptions o;
+    JointRate o;
     o.rate = Omega;
-    o.rate_given = true;
+    o.given = true;
     const Model m = build_model(c, n);
     VecX qb, vb;
-    app::joint_state(c, o, qb, vb);
+    joint_state(c, o, qb, vb);
     u.push_back(tip_motion(m, 0, solve_static(m, qb, vb, TipLoads{}).q)[0]);
   }
   const double p = std::log2(std::abs((u[1] - u[0]) / (u[2] - u[1])));

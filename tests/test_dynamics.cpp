@@ -6,9 +6,9 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
-#include "assembly/dense_reference.hpp"
-#include "solvers/integrator.hpp"
-#include "solvers/newton_system.hpp"
+#include "rfem/assembly/dense_reference.hpp"
+#include "rfem/solvers/integrator.hpp"
+#include "rfem/solvers/newton_system.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;
@@ -22,7 +22,7 @@ struct Trace {
 Trace run(const Model& m, const std::vector<JointInput>& in, IntegratorOptions o) {
   Trace tr;
   const RunOutcome r = integrate(m, in, o, [&](const OutputSample& x) { tr.s.push_back(x); });
-  EXPECT_TRUE(r.completed) << r.status;
+  EXPECT_TRUE(r.completed()) << r.status;
   std::printf("  t_end %.2f: %ld steps, %ld residuals, %ld factorisations\n", o.t_end, r.stats.steps,
               r.stats.residual_evals, r.stats.factorizations);
   return tr;
@@ -269,9 +269,10 @@ TEST(Dynamics, SchurSolveEqualsDenseSolveOfFullNewtonSystem) {
   test::random_state(m, 31, q, v, a);
   q.head(m.flexible_dofs()) *= 1e-3;  // a physical deformation: the random 5 cm would buckle the axial springs
   const int N = m.dof();
-  NewtonSystem ns(m, {m.flexible_dofs(), m.joint_index(1)}, LinearSolverKind::Chain, nullptr, true);
+  NewtonSystem ns(std::make_shared<const Model>(m), {m.flexible_dofs(), m.joint_index(1)}, LinearSolverKind::Chain, true);
   const double c = 350.0;
-  ASSERT_TRUE(ns.setup(q, v, 1.0 / c));
+  Workspace ws;
+  ASSERT_TRUE(ns.setup(q, v, 1.0 / c, ws));
   const MatX M = dense_mass_matrix(m, q), C = dense_damping(m, q, v), K = dense_stiffness(m, q, false);
   MatX J = MatX::Zero(2 * N, 2 * N);
   J.topLeftCorner(N, N) = c * MatX::Identity(N, N);

@@ -8,9 +8,9 @@
 
 #include <functional>
 
-#include "assembly/assemble.hpp"
-#include "assembly/dense_reference.hpp"
-#include "solvers/statics.hpp"
+#include "rfem/assembly/assemble.hpp"
+#include "rfem/assembly/dense_reference.hpp"
+#include "rfem/solvers/statics.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

@@ -11,11 +11,11 @@
 #include <limits>
 #include <sstream>
 
-#include "apps/simulate.hpp"
-#include "assembly/momentum.hpp"
-#include "solvers/integrator.hpp"
-#include "solvers/modes.hpp"
-#include "solvers/statics.hpp"
+#include "rfem/studies/inputs.hpp"
+#include "rfem/assembly/momentum.hpp"
+#include "rfem/solvers/integrator.hpp"
+#include "rfem/solvers/modes.hpp"
+#include "rfem/solvers/statics.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;
@@ -82,7 +82,7 @@ std::vector<OutputSample> run(const Model& m, const std::vector<JointInput>& in,
   o.atol_velocity = 1e-8;
   std::vector<OutputSample> s;
   const RunOutcome r = integrate(m, in, o, [&](const OutputSample& x) { s.push_back(x); });
-  EXPECT_TRUE(r.completed) << r.status;
+  EXPECT_TRUE(r.completed()) << r.status;
   return s;
 }
 
@@ -175,7 +175,7 @@ TEST(Links, TwoFlexibleLinksOnAFreeBusKeepMomentumAndCentreOfMass) {
                             "joints.0.input.feedforward=none", "joints.1.input.feedforward=none"});
   const Model m = build_model(c, 12);
   ASSERT_TRUE(m.free_base);
-  const auto s = run(m, app::joint_inputs(c), 3.0, 0.02);
+  const auto s = run(m, joint_inputs(c), 3.0, 0.02);
   double worst = 0.0, scale = 0.0, moved = 0.0, drift = 0.0;
   for (const auto& x : s) {
     worst = std::max({worst, x.momentum.linear.norm(), x.momentum.angular.norm()});
@@ -232,7 +232,7 @@ TEST(Links, OneLinkAtTheEndOfTheChainIsAsBeforeTopologies) {
     const Model m = build_model(c, 6);
     IntegratorOptions o = c.sim.options;
     std::vector<OutputSample> s;
-    ASSERT_TRUE(integrate(m, app::joint_inputs(c), o, [&](const OutputSample& x) { s.push_back(x); }).completed);
+    ASSERT_TRUE(integrate(m, joint_inputs(c), o, [&](const OutputSample& x) { s.push_back(x); }).completed());
     const std::vector<Expect>& want = bus ? space : paper;
     std::array<double, 6> peak{};  // of each series in the stored values' run (a floor for zeros)
     for (const auto& x : s)

@@ -2,7 +2,7 @@
 
 #include <random>
 
-#include "core/rotation.hpp"
+#include "rfem/core/rotation.hpp"
 
 namespace rfem::test {
 

@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include "assembly/assemble.hpp"
-#include "core/rotation.hpp"
+#include "rfem/assembly/assemble.hpp"
+#include "rfem/core/rotation.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

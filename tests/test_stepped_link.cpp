@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "apps/commands.hpp"
+#include "rfem/studies/quantities.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;
@@ -72,7 +72,7 @@ TEST(SteppedLink, ExtrapolatedFrequenciesMatchExactTwoSegmentBeam) {
     const auto exact = exact_frequencies(c.links[0].link.segments, along_z, 3);
     for (int k = 1; k <= 3; ++k) {
       std::vector<double> v;
-      for (int n : {24, 48, 96}) v.push_back(app::evaluate_quantity(c, n, std::string(name) + ":" + std::to_string(k), {}));
+      for (int n : {24, 48, 96}) v.push_back(evaluate_quantity(c, n, std::string(name) + ":" + std::to_string(k)));
       const double p = std::log2(std::abs((v[1] - v[0]) / (v[2] - v[1])));
       const double rich = v[2] + (v[2] - v[1]) / (std::pow(2.0, p) - 1.0);
       EXPECT_NEAR(p, 2.0, 0.2) << name << k;

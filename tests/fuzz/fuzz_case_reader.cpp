@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <string>
 
-#include "cases/case_file.hpp"
+#include "rfem/cases/case_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const std::string path = "/tmp/rfem_fuzz_" + std::to_string(getpid()) + ".toml";

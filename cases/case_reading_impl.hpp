@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "cases/case_file.hpp"
+#include "rfem/cases/case_file.hpp"
 
 namespace rfem::reading {
 
@@ -206,7 +206,7 @@ void read_links(const Reader& r, const toml::table& root, const Materials& mats,
                 std::vector<ParentRef>& parents);
 /// Resolves every parent name into the Mountings of c.joints and c.links, checks names are unique,
 /// points lie on their links and the mountings form no cycle.
-void resolve_mountings(const Reader& r, Case& c, const std::vector<ParentRef>& joint_parents,
+void resolve_parents(const Reader& r, Case& c, const std::vector<ParentRef>& joint_parents,
                        const std::vector<ParentRef>& link_parents);
 
 }  // namespace rfem::reading

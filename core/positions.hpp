@@ -1,0 +1,24 @@
+#pragma once
+// Where the points of a model are at full coordinates q (flexible first, joints last): link tips,
+// points along a link's elastic axis, joint frames; and the paper's tip deflections.
+#include "rfem/core/model.hpp"
+
+namespace rfem {
+
+/// Link l's free end: displacement (3, in its {r}) and small rotation φ of rfe_n (3) relative to
+/// undeformed. Zero for a rigid link.
+Vec6 tip_motion(const Model& model, int l, const VecX& q);
+/// The tip deflections in the paper's notation (docs/formulation.md §6): u1 along y of {r} (in the
+/// plane of joints 2 and 3 for the paper's manipulator), u2 along z, θ the torsion φ1 of rfe_n.
+Vec3 tip_deflection(const Model& model, int l, const VecX& q);
+/// The point at s along link l's elastic axis in {r}, moving with the rfe whose span holds it
+/// (rfe_0's span, or a rigid link: rigid with {r}).
+Vec3 point_in_link_frame(const Model& model, int l, double s, const VecX& q);
+/// The same point in the inertial frame {0}.
+Vec3 point_position(const Model& model, int l, double s, const VecX& q);
+/// Position of link l's free end (on the elastic axis) in the inertial frame {0}.
+Vec3 tip_position(const Model& model, int l, const VecX& q);
+/// Origin of every joint's frame (where the body it moves is placed) in {0}.
+std::vector<Vec3> joint_positions(const Model& model, const VecX& q);
+
+}  // namespace rfem

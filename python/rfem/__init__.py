@@ -1,0 +1,199 @@
+"""rfem: dynamics of manipulators with flexible links by the Rigid Finite Element Method.
+
+The same operations as the `rfem` program, from Python, with the same checks and messages:
+
+    import rfem
+    case = rfem.load("cases/paper_deployment.toml")          # a case file, checked
+    case = case.with_values({"joints.2.input.T": 10.0})        # the paths of `rfem --set`
+    runs = rfem.run(case, n=60)                                # rigid, kinematic, force
+    u1 = runs["force"].column("tip_deflection", 0)             # numpy, no copy
+    print(runs["force"].peaks, runs["force"].stats)
+
+    rfem.static(case), rfem.modes(case, count=6), rfem.refine(case, ns=[6, 12, 24], quantities=["peak:u1"])
+    rfem.plot("results.h5")                                    # the figures of `rfem plot`
+
+Errors in a case are `rfem.CaseError` (a ValueError) with the program's one-line message
+("FILE:LINE: key: what is wrong"); a results file that cannot be written is `rfem.ResultsError`
+(an OSError). Ctrl-C during a run stops it within a step and raises `rfem.RunInterrupted` (a
+KeyboardInterrupt) whose `.result` holds the runs so far. Long calls release the GIL.
+Units are SI; the results layout is README.md's "Results (HDF5)".
+"""
+import math as _math
+import json as _json
+import os as _os
+import subprocess as _subprocess
+import sys as _sys
+
+from . import _rfem
+from ._rfem import Case, CaseError, Model, ModesResult, ResultsError, Run, StaticResult, __version__, build
+
+__all__ = ["Case", "CaseError", "Model", "ModesResult", "ResultsError", "Run", "RunInterrupted", "Runs",
+           "StaticResult", "RefineResult", "load", "model", "run", "static", "modes", "refine", "plot",
+           "toml_value", "__version__"]
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """Ctrl-C (or an exception in a progress callback) stopped a study. `.result` holds what was
+    done: the runs so far (a Runs; the interrupted one with status "interrupted (signal 2)" and
+    every output up to the stop), or a RefineResult with the rows done."""
+
+    def __init__(self, result, message="interrupted"):
+        super().__init__(message)
+        self.result = result
+
+
+def toml_value(value):
+    """A Python value as a TOML literal (for Case.with_values): bool, int, float (inf, nan),
+    str, lists and dicts of these."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if _math.isnan(value):
+            return "nan"
+        if _math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        return repr(value)
+    if isinstance(value, str):
+        return _json.dumps(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k} = {toml_value(v)}" for k, v in value.items()) + "}"
+    if hasattr(value, "tolist"):  # numpy scalars and arrays
+        return toml_value(value.tolist())
+    raise TypeError(f"cannot write {type(value).__name__} as a TOML value")
+
+
+def _with_values(self, values):
+    """The case with new values at the paths of `rfem --set` ({"links.0.n": 48,
+    "joints.2.input.T": 10.0, "simulation.procedure": "single"}), read and checked again: a bad
+    value raises CaseError naming the key."""
+    return self.with_overrides([f"{k}={toml_value(v)}" for k, v in values.items()])
+
+
+Case.with_values = _with_values
+
+
+def load(path, values=None, overrides=()):
+    """Reads and checks a case file (TOML). `values`: {path: value} as in Case.with_values;
+    `overrides`: 'key.path=value' strings as given to `rfem --set`."""
+    case = Case.load(_os.fspath(path), list(overrides))
+    return case.with_values(values) if values else case
+
+
+def model(case, n=None):
+    """The case's Model with n rfes in all links (None: the case's own discretisation)."""
+    return _rfem.model(case, n or 0)
+
+
+class Runs(list):
+    """The runs of a study in order (a list of Run), also by name: runs["force"]."""
+
+    def __getitem__(self, key):
+        if isinstance(key, str):
+            for r in self:
+                if r.name == key or r.name.endswith("/" + key):
+                    return r
+            raise KeyError(f"no run named {key!r} (have {[r.name for r in self]})")
+        return super().__getitem__(key)
+
+    @property
+    def completed(self):
+        return all(r.completed for r in self)
+
+    warnings = ()
+
+
+def _raise(error, result):
+    if error is None:
+        return
+    if isinstance(error, KeyboardInterrupt):
+        raise RunInterrupted(result, "interrupted by Ctrl-C; the results so far are in .result") from error
+    raise error
+
+
+def run(case, n=None, output=None, runs=None, threads=0, keep_series=True, progress=None):
+    """Runs the case's [simulation] by its procedure (single: "run"; paper: "rigid", "kinematic",
+    "force") and returns the Runs.
+
+    n:           rfes in all links (None: the case's own)
+    output:      an HDF5 results file written while the runs go (the layout of `rfem run`)
+    runs:        a subset of the procedure's run names, e.g. ["rigid", "kinematic"]
+    threads:     kernel threads (0: each run times one thread against all)
+    keep_series: keep every series in memory (Run.table, Run.column); False keeps only summaries
+    progress:    called about ten times a second with {"run", "t", "t_end", "steps"}
+
+    A run that fails has status "failed: …" (the outputs before kept); Ctrl-C raises
+    RunInterrupted with the runs so far in .result."""
+    out, error, warnings = _rfem._run(case, n or 0, _os.fspath(output) if output else "", list(runs or []),
+                                      threads, keep_series, progress)
+    result = Runs(out)
+    result.warnings = warnings
+    _raise(error, result)
+    return result
+
+
+def static(case, n=None, rate=None, joint=1):
+    """Static equilibrium with the joints held at their values (or turning steadily: `rate`
+    [rad/s or m/s] of joint `joint`, from 1) under gravity and the case's tip loads. Returns a
+    StaticResult (tips per link, energies, coordinates)."""
+    return _rfem._static(case, n or 0, rate, joint)
+
+
+def modes(case, n=None, count=6, free=(), rate=None, joint=1):
+    """Natural frequencies and mode shapes of the flexible links about the static equilibrium,
+    joints held except those in `free` (numbers from 1, names, or "base"), optionally in a frame
+    turning at `rate` about joint `joint`. Returns a ModesResult (frequencies [Hz], kinds,
+    shapes, exact references for one uniform segment)."""
+    return _rfem._modes(case, n or 0, count, [str(f) for f in free], rate, joint)
+
+
+class RefineResult(dict):
+    """A refinement study: ["status"], ["ns"], and per quantity ["tables"][k] with "quantity",
+    "n", "value", "change", "order", "richardson" (arrays), "fitted_order",
+    "integration_error", "reference" and "warnings"; table("peak:u1") finds one by name."""
+
+    def table(self, quantity):
+        for t in self["tables"]:
+            if t["quantity"] == quantity:
+                return t
+        raise KeyError(quantity)
+
+
+def refine(case, ns, quantities, output=None, integration_check=True, rate=None, joint=1, threads=0, progress=None):
+    """Quantities over an increasing series of n with observed orders and Richardson values
+    (the quantities of `rfem refine`: "tip:uz", "bending-y:1", "peak:u1", "force/u1@10", …).
+    Dynamic quantities share one run per n; `output` keeps every run and the tables in HDF5.
+    Ctrl-C raises RunInterrupted with the rows done in .result."""
+    if isinstance(quantities, str):
+        quantities = [quantities]
+    out, error = _rfem._refine(case, list(ns), list(quantities), _os.fspath(output) if output else "", integration_check,
+                               rate, joint, threads, progress)
+    result = RefineResult(out)
+    _raise(error, result)
+    return result
+
+
+def _plot_script():
+    env = _os.environ.get("RFEM_PLOT_SCRIPT")
+    if env:
+        return env
+    here = _os.path.dirname(_os.path.abspath(__file__))
+    for candidate in (_os.path.join(here, "rfem_plot.py"),):
+        if _os.path.exists(candidate):
+            return candidate
+    raise FileNotFoundError("rfem_plot.py not found beside the rfem package (set RFEM_PLOT_SCRIPT)")
+
+
+def plot(results, outdir=None):
+    """The figures of `rfem plot` (PNG) for a results or refinement file (default directory: the
+    file's); returns the paths written. A file it cannot read raises RuntimeError with the
+    program's one-line message."""
+    cmd = [_sys.executable, _plot_script(), _os.fspath(results)] + (["-o", _os.fspath(outdir)] if outdir else [])
+    p = _subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode != 0:
+        lines = [l for l in p.stderr.strip().splitlines() if l.startswith("rfem plot: error: ")] or p.stderr.strip().splitlines()
+        raise RuntimeError(lines[-1].replace("rfem plot: error: ", "") if lines else "rfem plot failed")
+    return [l[len("wrote "):] for l in p.stdout.splitlines() if l.startswith("wrote ")]

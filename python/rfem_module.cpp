@@ -1,0 +1,407 @@
+// rfem's Python module (_rfem, wrapped by the package python/rfem/__init__.py): the library's
+// studies as Python calls. It translates arguments and results only: cases, runs, statics, modes
+// and refinement are library calls, with the library's checks and messages. Long calls release
+// the GIL; a heartbeat from the integration loop takes it back to poll Python's signals (Ctrl-C
+// stops the run within a step, its partial results kept) and to call the user's progress callback.
+// Series come back as read-only numpy views of the library's own buffers (no copy).
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <csignal>
+#include <memory>
+
+#include "rfem/cases/case_file.hpp"
+#include "rfem/results/errors.hpp"
+#include "rfem/studies/inputs.hpp"
+#include "rfem/studies/modes_study.hpp"
+#include "rfem/studies/recorders.hpp"
+#include "rfem/studies/refine.hpp"
+#include "rfem/studies/runs.hpp"
+#include "rfem/studies/static_study.hpp"
+#include "rfem/version.hpp"
+
+namespace py = pybind11;
+using namespace rfem;
+
+namespace {
+
+// A read-only numpy view of `rows` × `cols` doubles owned by `owner` (kept alive by the array).
+template <class Owner>
+py::array view(std::shared_ptr<Owner> owner, const double* data, long rows, long cols, bool flat = false) {
+  auto* keep = new std::shared_ptr<Owner>(std::move(owner));
+  py::capsule base(keep, [](void* p) { delete static_cast<std::shared_ptr<Owner>*>(p); });
+  std::vector<py::ssize_t> shape{rows}, strides{static_cast<py::ssize_t>(sizeof(double) * (flat ? 1 : cols))};
+  if (!flat) {
+    shape.push_back(cols);
+    strides.push_back(sizeof(double));
+  }
+  static const double empty = 0.0;  // numpy wants an address even for no data
+  py::array a(py::dtype::of<double>(), shape, strides, data ? data : &empty, base);
+  a.attr("flags").attr("writeable") = false;
+  return a;
+}
+
+py::array vector_array(const Eigen::VectorXd& v) { return py::array_t<double>(v.size(), v.data()); }
+
+// Collects what Python must see once the GIL is back: the first exception raised in a callback
+// (a KeyboardInterrupt from Ctrl-C, or the user's own), after which the study is stopped.
+struct Pending {
+  py::object error = py::none();
+  StopToken stop;
+  py::object progress = py::none();
+  double last_poll = 0.0;
+
+  // Polls Python's signals and calls the user's callback; called with the GIL released.
+  void beat(const Progress* p) {
+    py::gil_scoped_acquire gil;
+    if (!error.is_none()) return;
+    if (PyErr_CheckSignals() != 0) {
+      error = fetch();
+      stop.request(PyErr_GivenExceptionMatches(error.ptr(), PyExc_KeyboardInterrupt) ? SIGINT : 0);
+      return;
+    }
+    if (p && !progress.is_none()) {
+      try {
+        py::dict d;
+        d["run"] = p->run;
+        d["t"] = p->t;
+        d["t_end"] = p->t_end;
+        d["steps"] = p->steps;
+        progress(d);
+      } catch (py::error_already_set& e) {
+        error = e.value();
+        stop.request(PyErr_GivenExceptionMatches(error.ptr(), PyExc_KeyboardInterrupt) ? SIGINT : 0);
+      }
+    }
+  }
+  static py::object fetch() {
+    py::error_already_set e;
+    return e.value();
+  }
+};
+
+FileDescription python_description(const Case& cs, const std::string& call, const std::string& procedure, long n, long threads) {
+  std::string argv;
+  try {
+    py::gil_scoped_acquire gil;
+    for (auto a : py::module_::import("sys").attr("argv")) argv += (argv.empty() ? "" : " ") + py::str(a).cast<std::string>();
+  } catch (...) {
+  }
+  return describe(cs, argv + (argv.empty() ? "" : " ") + "(Python " + call + ")", procedure, n, threads);
+}
+
+py::dict stats_dict(const IntegratorStats& s) {
+  py::dict d;
+  d["steps"] = s.steps;
+  d["residual_evals"] = s.residual_evals;
+  d["factorizations"] = s.factorizations;
+  d["newton_iters"] = s.newton_iters;
+  d["newton_fails"] = s.newton_fails;
+  d["error_test_fails"] = s.error_test_fails;
+  d["last_step"] = s.last_step;
+  return d;
+}
+
+std::vector<RunName> run_names(const std::vector<std::string>& names) {
+  std::vector<RunName> out;
+  for (const auto& n : names) {
+    RunName r;
+    if (!parse(n, r)) throw py::value_error("no run named '" + n + "' (run, rigid, kinematic, force)");
+    out.push_back(r);
+  }
+  return out;
+}
+
+JointRate joint_rate(std::optional<double> rate, int joint) {
+  JointRate r;
+  r.given = rate.has_value();
+  r.rate = rate.value_or(0.0);
+  r.joint = joint;
+  return r;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_rfem, m) {
+  m.doc() = "rfem's compiled core; use the package `rfem` (help(rfem)).";
+  m.attr("__version__") = version_string;
+  m.attr("build") = build_description();
+  py::register_exception<CaseError>(m, "CaseError", PyExc_ValueError);
+  py::register_exception<ResultsError>(m, "ResultsError", PyExc_OSError);
+
+  py::class_<Case>(m, "Case", "A case: a TOML case file as read and checked (rfem.load, rfem.Case.from_text).")
+      .def_static("load", &read_case, py::arg("path"), py::arg("overrides") = std::vector<std::string>{},
+                  "Reads and checks a case file; overrides are 'key.path=value' strings (as rfem --set).")
+      .def_static("from_text", &parse_case, py::arg("text"), py::arg("name") = "<text>",
+                  py::arg("overrides") = std::vector<std::string>{}, py::arg("base_dir") = "",
+                  "A case from TOML text; `name` stands for the file in messages, table files are found in base_dir.")
+      .def("with_overrides", &with_overrides, py::arg("overrides"),
+           "The case with more 'key.path=value' overrides, read and checked again (CaseError names the key).")
+      .def_readonly("path", &Case::path)
+      .def_readonly("text", &Case::text, "the case file as read")
+      .def_readonly("effective_text", &Case::effective_text, "the case after its overrides, as TOML")
+      .def_readonly("overrides", &Case::overrides)
+      .def_readonly("warnings", &Case::warnings, "legal but suspicious values, one line each")
+      .def_property_readonly("name", [](const Case& c) { return c.name.empty() ? c.path : c.name; })
+      .def_readonly("description", &Case::description)
+      .def_property_readonly("links", [](const Case& c) {
+        std::vector<std::string> v;
+        for (const auto& l : c.links) v.push_back(l.name);
+        return v;
+      }, "the flexible links' names")
+      .def_property_readonly("joints", [](const Case& c) {
+        std::vector<std::string> v;
+        for (const auto& j : c.joints) v.push_back(j.name);
+        return v;
+      }, "the joints' names (a free base's six first)")
+      .def_property_readonly("procedure", [](const Case& c) { return to_string(c.sim.procedure); })
+      .def_readonly("has_simulation", &Case::has_simulation)
+      .def_property_readonly("t_end", [](const Case& c) { return c.sim.options.t_end; })
+      .def_property_readonly("output_dt", [](const Case& c) { return c.sim.options.output_dt; })
+      .def("__repr__", [](const Case& c) { return "<rfem.Case " + (c.name.empty() ? c.path : c.name) + ">"; });
+
+  py::class_<Model, std::shared_ptr<Model>>(m, "Model", "A case's model: its links cut into rfes, its joints.")
+      .def_property_readonly("n", &Model::n, "rfes of all links")
+      .def_property_readonly("m", &Model::m, "joints")
+      .def_property_readonly("dof", &Model::dof, "coordinates: 6 per rfe, one per joint")
+      .def_readonly("free_base", &Model::free_base)
+      .def_readonly("gravity", &Model::gravity)
+      .def_property_readonly("links", [](const Model& md) {
+        py::list out;
+        for (const auto& L : md.links) out.append(py::dict(py::arg("name") = L.name, py::arg("n") = L.n(), py::arg("length") = L.d.length));
+        return out;
+      })
+      .def_property_readonly("joints", [](const Model& md) {
+        py::list out;
+        for (const auto& j : md.joints)
+          out.append(py::dict(py::arg("name") = j.name, py::arg("type") = j.type == JointType::Revolute ? "revolute" : "prismatic"));
+        return out;
+      })
+      .def("__repr__", [](const Model& md) {
+        return "<rfem.Model n=" + std::to_string(md.n()) + " rfes, m=" + std::to_string(md.m()) + " joints>";
+      });
+  m.def("model", [](const Case& c, int n) { return std::const_pointer_cast<Model>(model_of(c, n)); }, py::arg("case"),
+        py::arg("n") = 0, "The case's model with n rfes in all (0: the case's own discretisation).");
+
+  py::class_<RunResult, std::shared_ptr<RunResult>>(m, "Run", "One run of a study: status, statistics, peaks and series.")
+      .def_readonly("name", &RunResult::name)
+      .def_property_readonly("status", [](const RunResult& r) { return r.status.to_string(); })
+      .def_property_readonly("completed", &RunResult::completed)
+      .def_readonly("wall_time", &RunResult::wall_s, "[s]")
+      .def_readonly("t_reached", &RunResult::t_reached, "[s]")
+      .def_readonly("outputs", &RunResult::samples)
+      .def_property_readonly("stats", [](const RunResult& r) { return stats_dict(r.stats); })
+      .def_property_readonly("peaks", [](const RunResult& r) {
+        py::dict d;
+        for (const auto& p : r.peaks) d[py::str(p.name)] = py::dict(py::arg("u1") = p.u1, py::arg("u2") = p.u2, py::arg("theta") = p.theta);
+        return d;
+      }, "per link: peak |u1|, |u2| [m], |theta| [rad]")
+      .def_readonly("energy_drift", &RunResult::energy_drift, "max |balance(t) - balance(0)| [J]")
+      .def_readonly("energy_scale", &RunResult::energy_scale, "[J]")
+      .def_property_readonly("model", [](const RunResult& r) { return std::const_pointer_cast<Model>(r.model); })
+      .def_property_readonly("names", [](const RunResult& r) {
+        return r.series ? r.series->names() : std::vector<std::string>{};
+      }, "the series kept (empty if the run kept none)")
+      .def("table", [](const std::shared_ptr<RunResult>& r, const std::string& name) {
+        if (!r->series) throw py::value_error("the run kept no series (keep_series=False)");
+        const RunSeries::View v = r->series->view(name);
+        return view(std::shared_ptr<const RunSeries>(r->series), v.data, v.rows, v.info->width());
+      }, py::arg("name"), "Series `name` (rows = outputs) as a read-only array, e.g. 'joint_tau', 'links/upper/tip_deflection'.")
+      .def("column", [](const std::shared_ptr<RunResult>& r, const std::string& name, int col) {
+        if (!r->series) throw py::value_error("the run kept no series (keep_series=False)");
+        const RunSeries::View v = r->series->view(name);
+        if (col < 0 || col >= v.info->width()) throw py::index_error("no column " + std::to_string(col) + " in " + name);
+        const long w = v.info->width();
+        auto* keep = new std::shared_ptr<const RunSeries>(r->series);
+        py::capsule base(keep, [](void* p) { delete static_cast<std::shared_ptr<const RunSeries>*>(p); });
+        static const double empty = 0.0;
+        py::array a(py::dtype::of<double>(), std::vector<py::ssize_t>{v.rows},
+                    std::vector<py::ssize_t>{static_cast<py::ssize_t>(sizeof(double) * w)}, v.data ? v.data + col : &empty, base);
+        a.attr("flags").attr("writeable") = false;
+        return a;
+      }, py::arg("name"), py::arg("column"), "One column of a series as a read-only 1-D array.")
+      .def("info", [](const RunResult& r, const std::string& name) {
+        if (!r.series) throw py::value_error("the run kept no series (keep_series=False)");
+        const SeriesInfo& i = *r.series->view(name).info;
+        return py::dict(py::arg("name") = i.name, py::arg("columns") = i.columns, py::arg("units") = i.units,
+                        py::arg("description") = i.description);
+      }, py::arg("name"), "Columns, units and description of series `name`.")
+      .def("__repr__", [](const RunResult& r) {
+        return "<rfem.Run " + r.name + ": " + r.status.to_string() + ", " + std::to_string(r.samples) + " outputs>";
+      });
+
+  m.def("_run", [](const Case& cs, int n, const std::string& output, const std::vector<std::string>& runs, int threads,
+                   bool keep_series, py::object progress) {
+    auto pending = std::make_shared<Pending>();
+    pending->progress = std::move(progress);
+    RunRequest rq;
+    rq.n = n;
+    rq.threads = threads;
+    rq.runs = run_names(runs);
+    rq.keep_series = keep_series;
+    rq.stop = pending->stop;
+    rq.progress = [pending](const Progress& p) { pending->beat(&p); };
+    rq.progress_interval = 0.1;
+    std::vector<std::string> warnings;
+    rq.warn = [&warnings](const std::string& w) { warnings.push_back(w); };
+    std::vector<RunResult> results;
+    {
+      py::gil_scoped_release release;
+      if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: missing table (t_end, output_dt, …) for a run");
+      if (cs.joints.empty()) throw CaseError(cs.path + ": joints: a run needs at least one base joint");
+      const auto model = model_of(cs, n);
+      const std::vector<JointInput> inputs = joint_inputs(cs, rq.warn);
+      std::unique_ptr<ResultsWriter> file;
+      std::unique_ptr<Hdf5Recorder> recorder;
+      if (!output.empty()) {
+        Parallelism p;
+        p.threads = threads;
+        file = std::make_unique<ResultsWriter>(
+            output, python_description(cs, "rfem.run", to_string(cs.sim.procedure), model->n(), p.max_threads()));
+        recorder = std::make_unique<Hdf5Recorder>(*file);
+        rq.observers.push_back(recorder.get());
+      }
+      results = run_case(cs, model, inputs, rq);
+      if (file) file->close();
+    }
+    py::list out;
+    for (auto& r : results) out.append(std::make_shared<RunResult>(std::move(r)));
+    py::object error = pending->error;
+    pending->progress = py::none();
+    return py::make_tuple(out, error, warnings);
+  }, py::arg("case"), py::arg("n"), py::arg("output"), py::arg("runs"), py::arg("threads"), py::arg("keep_series"),
+     py::arg("progress"));
+
+  py::class_<StaticStudy, std::shared_ptr<StaticStudy>>(m, "StaticResult", "A static equilibrium (rfem.static).")
+      .def_property_readonly("n", [](const StaticStudy& s) { return s.model->n(); })
+      .def_property_readonly("iterations", [](const StaticStudy& s) { return s.solution.iterations; })
+      .def_property_readonly("load_steps", [](const StaticStudy& s) { return s.solution.load_steps; })
+      .def_property_readonly("residual", [](const StaticStudy& s) { return s.solution.residual; }, "[N]")
+      .def_property_readonly("q", [](const StaticStudy& s) { return vector_array(s.solution.q); }, "all coordinates")
+      .def_property_readonly("elastic_energy", [](const StaticStudy& s) { return s.energies.elastic; }, "[J]")
+      .def_property_readonly("gravity_energy", [](const StaticStudy& s) { return s.energies.gravity; }, "[J]")
+      .def_property_readonly("tips", [](const StaticStudy& s) {
+        py::dict d;
+        for (const LinkTip& t : s.tips)
+          d[py::str(t.name)] = py::dict(py::arg("n") = t.n, py::arg("displacement") = vector_array(t.motion.head<3>()),
+                                        py::arg("rotation") = vector_array(t.motion.tail<3>()));
+        return d;
+      }, "per link: its free end's displacement [m] and rotation [rad] in its {r}")
+      .def_property_readonly("model", [](const StaticStudy& s) { return std::const_pointer_cast<Model>(s.model); });
+  m.def("_static", [](const Case& cs, int n, std::optional<double> rate, int joint) {
+    py::gil_scoped_release release;
+    return std::make_shared<StaticStudy>(static_study(cs, n, joint_rate(rate, joint)));
+  }, py::arg("case"), py::arg("n"), py::arg("rate"), py::arg("joint"));
+
+  py::class_<ModesStudy, std::shared_ptr<ModesStudy>>(m, "ModesResult", "Natural frequencies and mode shapes (rfem.modes).")
+      .def_property_readonly("n", [](const ModesStudy& s) { return s.model->n(); })
+      .def_property_readonly("solver", [](const ModesStudy& s) { return s.modes.dense ? "dense" : "lanczos"; })
+      .def_property_readonly("omega", [](const ModesStudy& s) { return vector_array(s.modes.omega); }, "[rad/s]")
+      .def_property_readonly("frequencies", [](const ModesStudy& s) { return vector_array(s.modes.omega / (2 * M_PI)); }, "[Hz]")
+      .def_property_readonly("kinds", [](const ModesStudy& s) {
+        std::vector<std::string> k;
+        for (ModeKind x : s.modes.kind) k.push_back(to_string(x));
+        return k;
+      }, "axial, bending-y, bending-z, torsion or rigid")
+      .def_readonly("index_of_kind", &ModesStudy::index_of_kind)
+      .def_property_readonly("shapes", [](const ModesStudy& s) { return py::array(py::cast(s.modes.shapes)); },
+                             "one column per mode: the rfe coordinates, then the free joints' (M-normalised)")
+      .def_property_readonly("equilibrium", [](const ModesStudy& s) { return vector_array(s.modes.q0); })
+      .def_property_readonly("uncertainty", [](const ModesStudy& s) { return vector_array(s.modes.uncertainty); })
+      .def_readonly("free_joints", &ModesStudy::free_names)
+      .def_readonly("has_reference", &ModesStudy::has_reference)
+      .def_property_readonly("reference", [](const ModesStudy& s) -> py::object {
+        if (!s.has_reference) return py::none();
+        py::list out;
+        for (const auto& r : s.reference)
+          out.append(py::dict(py::arg("hz") = r.reference_hz, py::arg("theory") = r.theory, py::arg("relative_error") = r.relative_error,
+                              py::arg("euler_bernoulli_hz") = r.euler_bernoulli_hz ? py::cast(*r.euler_bernoulli_hz) : py::none()));
+        return out;
+      }, "per mode, for one uniform segment: the exact value it converges to")
+      .def_readonly("warnings", &ModesStudy::warnings)
+      .def_property_readonly("model", [](const ModesStudy& s) { return std::const_pointer_cast<Model>(s.model); });
+  m.def("_modes", [](const Case& cs, int n, int count, const std::vector<std::string>& free, std::optional<double> rate,
+                     int joint) {
+    ModesRequest rq;
+    rq.n = n;
+    rq.count = count;
+    rq.free = free;
+    rq.rate = joint_rate(rate, joint);
+    py::gil_scoped_release release;
+    return std::make_shared<ModesStudy>(modes_study(cs, rq));
+  }, py::arg("case"), py::arg("n"), py::arg("count"), py::arg("free"), py::arg("rate"), py::arg("joint"));
+
+  m.def("_refine", [](const Case& cs, const std::vector<int>& ns, const std::vector<std::string>& quantities,
+                      const std::string& output, bool integration_check, std::optional<double> rate, int joint, int threads,
+                      py::object progress) {
+    auto pending = std::make_shared<Pending>();
+    pending->progress = std::move(progress);
+    RefineRequest rq;
+    rq.ns = ns;
+    rq.quantities = quantities;
+    rq.integration_check = integration_check;
+    rq.rate = joint_rate(rate, joint);
+    rq.threads = threads;
+    rq.stop = pending->stop;
+    rq.progress = [pending](const Progress& p) { pending->beat(&p); };
+    rq.on_n = [pending](int, int, int) { pending->beat(nullptr); };
+    std::vector<std::string> warnings;
+    rq.warn = [&warnings](const std::string& w) { warnings.push_back(w); };
+    RefineResult res;
+    {
+      py::gil_scoped_release release;
+      const std::vector<Quantity> qs = check_refinement(cs, rq);
+      std::unique_ptr<ResultsWriter> file;
+      std::unique_ptr<Hdf5Recorder> recorder;
+      if (!output.empty()) {
+        Parallelism p;
+        p.threads = threads;
+        file = std::make_unique<ResultsWriter>(output, python_description(cs, "rfem.refine", "refine", -1, p.max_threads()));
+        recorder = std::make_unique<Hdf5Recorder>(*file);
+        rq.observers.push_back(recorder.get());
+      }
+      res = refine(cs, rq);
+      if (file) {
+        file->write_refinement(quantities, res.ns, res.tables, res.status);
+        file->close();
+      }
+    }
+    py::dict out;
+    out["status"] = res.status.to_string();
+    out["ns"] = res.ns;
+    py::list tables;
+    for (size_t k = 0; k < res.tables.size(); ++k) {
+      const Refinement& t = res.tables[k];
+      std::vector<int> n;
+      std::vector<double> value, change, order, rich;
+      for (const auto& r : t.rows) {
+        n.push_back(r.n);
+        value.push_back(r.value);
+        change.push_back(r.change);
+        order.push_back(r.order);
+        rich.push_back(r.richardson);
+      }
+      py::dict d;
+      d["quantity"] = res.quantities[k].text;
+      d["n"] = py::array(py::cast(n));
+      d["value"] = py::array(py::cast(value));
+      d["change"] = py::array(py::cast(change));
+      d["order"] = py::array(py::cast(order));
+      d["richardson"] = py::array(py::cast(rich));
+      d["fitted_order"] = t.fitted_order;
+      d["integration_error"] = t.integration_error;
+      d["reference"] = t.reference();
+      d["warnings"] = t.warnings;
+      tables.append(d);
+    }
+    out["tables"] = tables;
+    out["warnings"] = warnings;
+    py::object error = pending->error;
+    pending->progress = py::none();
+    return py::make_tuple(out, error);
+  }, py::arg("case"), py::arg("ns"), py::arg("quantities"), py::arg("output"), py::arg("integration_check"),
+     py::arg("rate"), py::arg("joint"), py::arg("threads"), py::arg("progress"));
+}

@@ -1,0 +1,83 @@
+#include "rfem/results/reader.hpp"
+
+#include "rfem/results/h5_impl.hpp"
+
+namespace rfem {
+
+std::vector<double> Table::column(long c) const {
+  std::vector<double> out(static_cast<size_t>(rows));
+  for (long r = 0; r < rows; ++r) out[static_cast<size_t>(r)] = at(r, c);
+  return out;
+}
+
+struct ResultsReader::Impl {
+  std::string path;
+  h5::Handle file;
+};
+
+ResultsReader::ResultsReader(const std::string& path) : impl_(std::make_unique<Impl>()) {
+  const h5::Quiet quiet;
+  impl_->path = path;
+  const h5::Handle fapl = h5::plist(H5Pcreate(H5P_FILE_ACCESS), path);
+  // A file being written (SWMR) is read with SWMR too; a finished one opens either way.
+  hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, fapl);
+  if (id < 0) id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl);
+  impl_->file = h5::file(id, path + ": not a readable HDF5 results file");
+}
+
+ResultsReader::~ResultsReader() {
+  if (impl_) {
+    const h5::Quiet quiet;
+    impl_->file.reset();
+  }
+}
+ResultsReader::ResultsReader(ResultsReader&&) noexcept = default;
+ResultsReader& ResultsReader::operator=(ResultsReader&&) noexcept = default;
+
+const std::string& ResultsReader::path() const { return impl_->path; }
+
+bool ResultsReader::has(const std::string& object) const {
+  const h5::Quiet quiet;
+  // Every link on the way must exist (H5Lexists fails on a missing intermediate group).
+  for (size_t pos = 0;;) {
+    pos = object.find('/', pos + 1);
+    const std::string prefix = object.substr(0, pos);
+    if (!prefix.empty() && prefix != "/" && H5Lexists(impl_->file, prefix.c_str(), H5P_DEFAULT) <= 0) return false;
+    if (pos == std::string::npos) break;
+  }
+  return H5Oexists_by_name(impl_->file, object.c_str(), H5P_DEFAULT) > 0;
+}
+
+Table ResultsReader::table(const std::string& object) const {
+  const h5::Quiet quiet;
+  const std::string what = impl_->path + ": " + object;
+  if (!has(object)) throw ResultsError(what + ": no such dataset");
+  const h5::Handle d = h5::dataset(H5Dopen2(impl_->file, object.c_str(), H5P_DEFAULT), what);
+  const h5::Handle s = h5::space(H5Dget_space(d), what);
+  const int rank = H5Sget_simple_extent_ndims(s);
+  if (rank != 2) throw ResultsError(what + ": a table has 2 dimensions, this one " + std::to_string(rank));
+  hsize_t dims[2] = {0, 0};
+  h5::check(H5Sget_simple_extent_dims(s, dims, nullptr), what);
+  const h5::Handle t = h5::type(H5Dget_type(d), what);
+  if (H5Tget_class(t) != H5T_FLOAT) throw ResultsError(what + ": not a table of numbers");
+  Table out;
+  out.rows = static_cast<long>(dims[0]);
+  out.cols = static_cast<long>(dims[1]);
+  out.data.resize(dims[0] * dims[1]);
+  if (!out.data.empty()) h5::check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data.data()), what);
+  return out;
+}
+
+std::string ResultsReader::attribute(const std::string& object, const std::string& key, const std::string& fallback) const {
+  const h5::Quiet quiet;
+  if (object != "/" && !has(object)) return fallback;
+  const h5::Handle o = h5::object(H5Oopen(impl_->file, object.c_str(), H5P_DEFAULT), impl_->path + ": " + object);
+  std::string v;
+  try {
+    if (h5::read_string_attribute(o, key, v)) return v;
+  } catch (const ResultsError&) {
+  }
+  return fallback;
+}
+
+}  // namespace rfem

@@ -1,0 +1,45 @@
+#pragma once
+// Reading a results file back: the series of a run group and its string attributes, every shape
+// checked (a file that rfem did not write, or another program changed, gives ResultsError, never a
+// read past an array).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rfem/results/errors.hpp"
+
+namespace rfem {
+
+/// A 2-D table of doubles, row-major.
+struct Table {
+  long rows = 0, cols = 0;
+  std::vector<double> data;
+  double at(long r, long c) const { return data[static_cast<size_t>(r * cols + c)]; }
+  /// Column c as a vector.
+  std::vector<double> column(long c) const;
+};
+
+class ResultsReader {
+ public:
+  /// Opens a results file read-only (also while a run writes it: SWMR). Throws ResultsError
+  /// ("PATH: not a readable HDF5 results file").
+  explicit ResultsReader(const std::string& path);
+  ~ResultsReader();
+  ResultsReader(ResultsReader&&) noexcept;
+  ResultsReader& operator=(ResultsReader&&) noexcept;
+  ResultsReader(const ResultsReader&) = delete;
+  ResultsReader& operator=(const ResultsReader&) = delete;
+  const std::string& path() const;
+  /// Whether `object` ("force", "force/joint_tau") exists.
+  bool has(const std::string& object) const;
+  /// The 2-D float64 dataset `object`; throws ResultsError if it is missing or not 2-D.
+  Table table(const std::string& object) const;
+  /// The string attribute `key` of `object` ("/" for the file); `fallback` if there is none.
+  std::string attribute(const std::string& object, const std::string& key, const std::string& fallback = "") const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rfem

@@ -1,0 +1,89 @@
+#pragma once
+// HDF5 results files: one group per run with chunked, extendible datasets along time (the layout
+// of results/layout.hpp), flushed as the run goes, so a run that fails or is interrupted leaves a
+// valid file with every completed output step and a `status` saying why it stopped. While a run
+// writes, the file is in HDF5's single-writer / multiple-reader (SWMR) mode: h5py
+// (`h5py.File(path, "r", swmr=True)`) can watch it, and the run's `status_now` dataset says
+// `running`. SWMR allows no new objects or attributes, so what a run learns at its end is written
+// when SWMR ends (the file is closed and reopened). Every HDF5 call is checked: a failure throws
+// ResultsError naming the file. Layout documented in README.md ("Results").
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rfem/results/errors.hpp"
+#include "rfem/results/layout.hpp"
+#include "rfem/solvers/integrator.hpp"
+#include "rfem/solvers/refinement.hpp"
+
+namespace rfem {
+
+/// File attributes that let a results file describe its own run.
+struct FileDescription {
+  std::string command_line;    ///< how the file was made (the program's arguments, or a script's note)
+  std::string case_path;
+  std::string case_text;       ///< the case file as read
+  std::string case_effective;  ///< the case after the overrides, as TOML
+  std::string overrides;       ///< the --set values, one per line
+  std::string procedure;       ///< single | paper | refine
+  long n = -1;                 ///< rfes of every run in the file (−1: not one n, as in a refinement)
+  long threads = 0;            ///< the largest thread team of the runs
+};
+
+/// What a run group records about the run besides its series.
+struct RunDescription {
+  IntegratorOptions options;
+  std::vector<std::string> inputs;  ///< per joint: motion, torque or feedback
+  int flexible_every = 0;           ///< store the rfe coordinates every k outputs (0: never)
+  long threads = 0;
+};
+
+class RunWriter;
+
+/// A results file, created (or truncated) on construction. Movable, not copyable; closing never
+/// throws from the destructor (close() reports a failure).
+class ResultsWriter {
+ public:
+  ResultsWriter(const std::string& path, const FileDescription& description);
+  ~ResultsWriter();
+  ResultsWriter(ResultsWriter&&) noexcept;
+  ResultsWriter& operator=(ResultsWriter&&) noexcept;
+  ResultsWriter(const ResultsWriter&) = delete;
+  ResultsWriter& operator=(const ResultsWriter&) = delete;
+  const std::string& path() const;
+  /// A new run group `name` ("run", "n12/kinematic"): its series are written by the returned
+  /// writer, which must be finished before the next run begins.
+  std::unique_ptr<RunWriter> begin_run(const std::string& name, std::shared_ptr<const Model> model,
+                                       const RunDescription& description);
+  /// The group `refine`: n and, per quantity, refine/q<k> with value, change, order, richardson
+  /// and its assessment; the first quantity's datasets also directly in `refine`.
+  void write_refinement(const std::vector<std::string>& quantities, const std::vector<int>& ns,
+                        const std::vector<Refinement>& tables, const RunStatus& status);
+  /// Flushes and closes the file; throws ResultsError if HDF5 cannot.
+  void close();
+
+  struct File;  // (shared with the run writers)
+ private:
+  std::shared_ptr<File> file_;
+};
+
+/// One run's group. Appends output samples; finish() writes how the run ended. Made by
+/// ResultsWriter::begin_run; shares the file with it.
+class RunWriter {
+ public:
+  ~RunWriter();  ///< closes the group (the status stays `running` unless finished)
+  RunWriter(const RunWriter&) = delete;
+  RunWriter& operator=(const RunWriter&) = delete;
+  void append(const OutputSample& s);
+  /// Writes the status, the integrator's statistics and the wall time, and leaves SWMR mode.
+  void finish(const RunOutcome& outcome, double wall_s);
+  long samples() const;
+
+  struct Impl;
+  explicit RunWriter(std::unique_ptr<Impl> impl);
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rfem

@@ -1,0 +1,39 @@
+#include "rfem/studies/recorders.hpp"
+
+namespace rfem {
+
+void Hdf5Recorder::begin(const RunInfo& info) {
+  run_.reset();
+  RunDescription d;
+  d.options = info.options;
+  d.inputs = info.inputs;
+  d.flexible_every = info.flexible_every;
+  d.threads = info.threads;
+  run_ = file_.begin_run(info.name, info.model, d);
+}
+
+void Hdf5Recorder::sample(const OutputSample& s) { run_->append(s); }
+
+void Hdf5Recorder::end(const RunResult& r) {
+  RunOutcome o;
+  o.status = r.status;
+  o.t_reached = r.t_reached;
+  o.stats = r.stats;
+  run_->finish(o, r.wall_s);
+}
+
+FileDescription describe(const Case& cs, const std::string& command_line, const std::string& procedure, long n,
+                         long threads) {
+  FileDescription d;
+  d.command_line = command_line;
+  d.case_path = cs.path;
+  d.case_text = cs.text;
+  d.case_effective = cs.effective_text;
+  for (const auto& o : cs.overrides) d.overrides += (d.overrides.empty() ? "" : "\n") + o;
+  d.procedure = procedure;
+  d.n = n;
+  d.threads = threads;
+  return d;
+}
+
+}  // namespace rfem

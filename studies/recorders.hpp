@@ -1,0 +1,33 @@
+#pragma once
+// Observers that record a study's runs: into an HDF5 results file (one group per run, written as
+// the run goes: results/writer.hpp).
+#include <memory>
+
+#include "rfem/results/writer.hpp"
+#include "rfem/studies/runs.hpp"
+
+namespace rfem {
+
+/// Writes every run it observes into `file` (which the caller keeps alive). A write that fails
+/// (a full disk) ends the run as failed with the writer's message.
+class Hdf5Recorder : public RunObserver {
+ public:
+  explicit Hdf5Recorder(ResultsWriter& file) : file_(file) {}
+  void begin(const RunInfo& info) override;
+  void sample(const OutputSample& s) override;
+  void end(const RunResult& r) override;
+  /// Output steps written of the current (or last) run.
+  long samples() const { return run_ ? run_->samples() : 0; }
+
+ private:
+  ResultsWriter& file_;
+  std::unique_ptr<RunWriter> run_;
+};
+
+/// The attributes that let a results file describe its study: the case as read and after its
+/// overrides, how the file was made, the procedure ("single", "paper", "refine"), n (−1: several),
+/// the threads.
+FileDescription describe(const Case& cs, const std::string& command_line, const std::string& procedure, long n,
+                         long threads);
+
+}  // namespace rfem

@@ -1,0 +1,46 @@
+#pragma once
+// A refinement study (`rfem refine`): quantities over an increasing series of n, with changes,
+// observed orders, Richardson values where the series can be trusted (solvers/refinement.hpp),
+// and — for dynamic quantities — the integration error of the finest run, from a rerun at
+// tolerances 100 times tighter. Dynamic quantities share one run of the procedure per n; only the
+// runs they name are run.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "rfem/solvers/refinement.hpp"
+#include "rfem/studies/quantities.hpp"
+#include "rfem/studies/runs.hpp"
+
+namespace rfem {
+
+struct RefineRequest {
+  std::vector<int> ns;                  ///< strictly increasing, at least two
+  std::vector<std::string> quantities;  ///< at least one (studies/quantities.hpp)
+  bool integration_check = true;        ///< rerun the finest n at 100× tighter tolerances
+  JointRate rate;                       ///< for static and modal quantities
+  int threads = 0;
+  StopToken stop;                       ///< ends the study after the current run; rows done are kept
+  /// Before each n (index from 0, count, n; index = count for the integration check).
+  std::function<void(int index, int count, int n)> on_n;
+  std::function<void(const Progress&)> progress;  ///< inside each run
+  std::vector<RunObserver*> observers;  ///< see every run ("n12/kinematic", "check_n24/run")
+  Warnings warn;
+};
+
+struct RefineResult {
+  std::vector<Quantity> quantities;
+  std::vector<int> ns;                 ///< the n done (all, unless stopped)
+  std::vector<Refinement> tables;      ///< per quantity
+  RunStatus status;                    ///< completed, or interrupted
+  bool dynamic = false;                ///< some quantity needed runs
+};
+
+/// Checks every quantity and every n before the first run (CaseError), then runs the study.
+/// A run that does not complete throws std::runtime_error ("n = 24: force failed: …").
+RefineResult refine(const Case& cs, const RefineRequest& request);
+
+/// Checks a request without running it (what refine() checks first); returns the parsed quantities.
+std::vector<Quantity> check_refinement(const Case& cs, const RefineRequest& request);
+
+}  // namespace rfem

@@ -1,0 +1,141 @@
+#include "rfem/studies/runs.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "rfem/core/positions.hpp"
+#include "rfem/studies/inputs.hpp"
+
+namespace rfem {
+
+RunSeries::View RunSeries::view(const std::string& wanted) const {
+  std::string name = wanted;
+  for (const auto& [alias, target] : layout.aliases)
+    if (alias == name) name = target;
+  for (size_t i = 0; i < layout.series.size(); ++i)
+    if (layout.series[i].name == name) return {&layout.series[i], data[i].data(), rows};
+  for (size_t i = 0; i < layout.flexible.size(); ++i)
+    if (layout.flexible[i].name == name) return {&layout.flexible[i], flexible[i].data(), flexible_rows};
+  for (const auto& [info, values] : layout.constants)
+    if (info.name == name) return {&info, values.data(), static_cast<long>(values.size()) / info.width()};
+  throw std::out_of_range("no series named '" + wanted + "'");
+}
+
+Table RunSeries::table(const std::string& name) const {
+  const View v = view(name);
+  Table t;
+  t.rows = v.rows;
+  t.cols = v.info->width();
+  t.data.assign(v.data, v.data + t.rows * t.cols);
+  return t;
+}
+
+std::vector<std::string> RunSeries::names() const {
+  std::vector<std::string> out;
+  for (const auto& s : layout.series) out.push_back(s.name);
+  for (const auto& s : layout.flexible) out.push_back(s.name);
+  for (const auto& [s, v] : layout.constants) out.push_back(s.name);
+  for (const auto& [alias, target] : layout.aliases) out.push_back(alias);
+  return out;
+}
+
+namespace {
+
+RunResult run_one(const std::string& name, std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs,
+                  const Case& cs, const RunRequest& rq) {
+  RunResult s;
+  s.name = name;
+  s.model = model;
+  for (const MountedLink& L : model->links) s.peaks.push_back({L.name});
+  IntegratorOptions o = cs.sim.options;
+  o.parallel.threads = rq.threads;
+  const RunInfo info{name, model, o, input_kinds(inputs), cs.sim.flexible_every, o.parallel.max_threads()};
+  for (RunObserver* obs : rq.observers) obs->begin(info);
+  if (rq.keep_series) {
+    s.series = std::make_shared<RunSeries>();
+    s.series->layout = run_layout(*model, cs.sim.flexible_every);
+    s.series->data.resize(s.series->layout.series.size());
+    s.series->flexible.resize(s.series->layout.flexible.size());
+  }
+  std::vector<std::vector<double>> rows;
+  double balance0 = NAN;
+  const Model& m = *model;
+  auto sink = [&](const OutputSample& x) {
+    for (RunObserver* obs : rq.observers) obs->sample(x);
+    if (RunSeries* ser = s.series.get()) {
+      sample_rows(m, ser->layout, x, rows);
+      for (size_t i = 0; i < rows.size(); ++i) ser->data[i].insert(ser->data[i].end(), rows[i].begin(), rows[i].end());
+      if (!ser->layout.flexible.empty() && ser->rows % ser->layout.flexible_every == 0) {
+        flexible_rows(m, ser->layout, x, rows);
+        for (size_t i = 0; i < rows.size(); ++i) ser->flexible[i].insert(ser->flexible[i].end(), rows[i].begin(), rows[i].end());
+        ++ser->flexible_rows;
+      }
+      ++ser->rows;
+    }
+    for (size_t l = 0; l < s.peaks.size(); ++l) {
+      const Vec3 u = tip_deflection(m, static_cast<int>(l), x.q);
+      LinkPeaks& pk = s.peaks[l];
+      pk.u1 = std::max(pk.u1, std::abs(u[0]));
+      pk.u2 = std::max(pk.u2, std::abs(u[1]));
+      pk.theta = std::max(pk.theta, std::abs(u[2]));
+    }
+    const double bal = x.energy_balance();
+    if (std::isnan(balance0)) balance0 = bal;
+    s.energy_drift = std::max(s.energy_drift, std::abs(bal - balance0));
+    s.energy_scale = std::max({s.energy_scale, x.energy.kinetic, std::abs(x.energy.elastic), std::abs(x.input_work)});
+    ++s.samples;
+  };
+  RunControl control;
+  control.stop = rq.stop;
+  control.heartbeat_interval = rq.progress_interval;
+  if (rq.progress) control.heartbeat = [&](double t, long steps) { rq.progress({name, t, o.t_end, steps}); };
+  const auto t0 = std::chrono::steady_clock::now();
+  const RunOutcome r = integrate(model, inputs, o, sink, control);
+  s.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s.status = r.status;
+  s.stats = r.stats;
+  s.t_reached = r.t_reached;
+  for (RunObserver* obs : rq.observers) obs->end(s);
+  return s;
+}
+
+}  // namespace
+
+std::vector<RunResult> run_case(const Case& cs, const RunRequest& rq) {
+  if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: missing table (t_end, output_dt, …) for `rfem run`");
+  if (cs.joints.empty()) throw CaseError(cs.path + ": joints: `rfem run` needs at least one base joint");
+  const auto model = model_of(cs, rq.n);
+  return run_case(cs, model, joint_inputs(cs, rq.warn), rq);
+}
+
+std::vector<RunResult> run_case(const Case& cs, std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs,
+                                const RunRequest& rq) {
+  if (!model) throw std::invalid_argument("run_case: no model");
+  if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: missing table (t_end, output_dt, …) for `rfem run`");
+  if (static_cast<int>(inputs.size()) != model->m())
+    throw std::invalid_argument("run_case: one input per joint is required (" + std::to_string(model->m()) + ")");
+  const std::vector<RunName> all = runs_of(cs.sim.procedure);
+  for (RunName r : rq.runs)
+    if (std::find(all.begin(), all.end(), r) == all.end())
+      throw CaseError(cs.path + ": simulation.procedure: " + to_string(cs.sim.procedure) + " has no run '" + to_string(r) + "'");
+  auto wanted = [&](RunName r) { return rq.runs.empty() || std::find(rq.runs.begin(), rq.runs.end(), r) != rq.runs.end(); };
+  std::vector<RunResult> runs;
+  auto go_on = [&] { return runs.empty() || (runs.back().completed() && !rq.stop.requested()); };
+  if (cs.sim.procedure == Procedure::Paper) {
+    for (size_t j = 0; j < inputs.size(); ++j)
+      if (!inputs[j].prescribed())
+        throw CaseError(cs.inputs[j].where + ": the paper procedure needs a motion law on every joint");
+    const auto rigid = std::make_shared<const Model>(rigidify(*model));
+    if (wanted(RunName::Rigid)) runs.push_back(run_one(rq.prefix + "rigid", rigid, inputs, cs, rq));
+    if (wanted(RunName::Kinematic) && go_on()) runs.push_back(run_one(rq.prefix + "kinematic", model, inputs, cs, rq));
+    if (wanted(RunName::Force) && go_on())
+      runs.push_back(run_one(rq.prefix + "force", model, rigid_torque_inputs(rigid, inputs), cs, rq));
+  } else {
+    runs.push_back(run_one(rq.prefix + "run", model, inputs, cs, rq));
+  }
+  return runs;
+}
+
+}  // namespace rfem

@@ -1,0 +1,112 @@
+#pragma once
+// Running a case's [simulation] by its procedure: one run, or the paper's three (rigid inverse
+// dynamics, kinematic input, force input with the rigid torques). Results come back in memory —
+// status, statistics, peaks, the energy balance and, if kept, every series of the results layout
+// (results/layout.hpp) — and stream to any observers while the runs go (an HDF5 file through
+// studies/recorders.hpp). A stop token ends a run cleanly within a step; progress goes to a
+// callback; warnings are returned, never printed.
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rfem/cases/case_file.hpp"
+#include "rfem/results/layout.hpp"
+#include "rfem/results/reader.hpp"
+#include "rfem/solvers/integrator.hpp"
+#include "rfem/studies/common.hpp"
+
+namespace rfem {
+
+/// Peaks over a run of one link's tip deflections (tip_deflection: |u1|, |u2|, |θ|).
+struct LinkPeaks {
+  std::string name;
+  double u1 = 0, u2 = 0, theta = 0;
+};
+
+/// A run's series kept in memory, in the layout of results/layout.hpp.
+struct RunSeries {
+  RunLayout layout;
+  std::vector<std::vector<double>> data;      ///< per layout.series: rows × width, row-major
+  std::vector<std::vector<double>> flexible;  ///< per layout.flexible
+  long rows = 0, flexible_rows = 0;
+  /// A table without copying it: its description, its first value (row-major) and its rows.
+  struct View {
+    const SeriesInfo* info = nullptr;
+    const double* data = nullptr;
+    long rows = 0;
+  };
+  /// The table `name`: a series, a flexible series, a constant, or an alias ("tip"). Throws
+  /// std::out_of_range for an unknown name.
+  View view(const std::string& name) const;
+  /// A copy of it.
+  Table table(const std::string& name) const;
+  /// Every name table() knows.
+  std::vector<std::string> names() const;
+};
+
+struct RunResult {
+  std::string name;  ///< its group: the request's prefix and "run", "rigid", "kinematic" or "force"
+  RunStatus status;
+  double wall_s = 0, t_reached = 0;
+  IntegratorStats stats;
+  long samples = 0;                     ///< output steps delivered
+  std::vector<LinkPeaks> peaks;         ///< per link (empty without links)
+  /// max |balance(t) − balance(0)| with balance = T + V + dissipated − input work [J], and the
+  /// largest of T, |V_e|, |input work| for scale.
+  double energy_drift = 0, energy_scale = 0;
+  std::shared_ptr<const Model> model;   ///< the model it ran (rigidified for `rigid`)
+  std::shared_ptr<RunSeries> series;    ///< null unless the request keeps series
+  bool completed() const { return status.is_completed(); }
+};
+
+/// What an observer learns when a run starts.
+struct RunInfo {
+  std::string name;
+  std::shared_ptr<const Model> model;
+  IntegratorOptions options;
+  std::vector<std::string> inputs;  ///< per joint: motion, torque or feedback
+  int flexible_every = 0;
+  long threads = 0;                 ///< the largest team the run may use
+};
+
+/// Sees every run of a study as it goes. A throwing sample() ends that run as failed with the
+/// message (the samples before it stay delivered); a throwing begin() or end() ends the study.
+class RunObserver {
+ public:
+  virtual ~RunObserver() = default;
+  virtual void begin(const RunInfo&) {}
+  virtual void sample(const OutputSample&) {}
+  virtual void end(const RunResult&) {}
+};
+
+/// Where a run is, for a progress display.
+struct Progress {
+  std::string run;
+  double t = 0, t_end = 0;
+  long steps = 0;
+};
+
+struct RunRequest {
+  int n = 0;                  ///< rfes in all links (0: the case's own discretisation)
+  int threads = 0;            ///< the kernels' team (0: each run times one thread against all)
+  std::vector<RunName> runs;  ///< which of the procedure's runs (empty: all; the paper's force run
+                              ///< needs no other)
+  std::string prefix;         ///< put before every run's name ("n12/")
+  bool keep_series = true;    ///< keep every series in memory (RunResult::series)
+  StopToken stop;             ///< request() ends the current run within a step, and the study
+  /// Called on the integrating thread at most every progress_interval seconds.
+  std::function<void(const Progress&)> progress;
+  double progress_interval = 0.2;
+  std::vector<RunObserver*> observers;  ///< the caller keeps them alive for the call
+  Warnings warn;
+};
+
+/// Runs the case's procedure on its model with n rfes (CaseError for a case without
+/// [simulation] or joints, or bad inputs). A run that does not complete ends the procedure.
+std::vector<RunResult> run_case(const Case& cs, const RunRequest& request);
+/// The same on a given model with given inputs (one per joint).
+std::vector<RunResult> run_case(const Case& cs, std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs,
+                                const RunRequest& request);
+
+}  // namespace rfem
