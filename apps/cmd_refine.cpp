@@ -52,7 +52,7 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
       const std::string stem = cs.path.substr(cs.path.find_last_of('/') + 1);
       path = stem.substr(0, stem.rfind('.')) + "_refine.h5";
     }
-    file = std::make_unique<ResultsWriter>(path, describe(cs, c.command_line, "refine", -1, max_threads(c)));
+    file = std::make_unique<ResultsWriter>(create_results(path, describe(cs, c.command_line, "refine", -1, max_threads(c))));
   }
   const bool quiet = c.json || c.quiet;
   if (dynamic) check_run_cost(cs, model_of(cs, ro.ns.back()), joint_inputs(cs), c);

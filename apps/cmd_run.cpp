@@ -60,7 +60,7 @@ int run_simulation(const Common& c, const std::string& output) {
   check_run_cost(cs, model, inputs, c);
   RunRequest rq;
   const SignalStop signals(rq.stop);
-  ResultsWriter file(output, describe(cs, c.command_line, to_string(cs.sim.procedure), model->n(), max_threads(c)));
+  ResultsWriter file = create_results(output, describe(cs, c.command_line, to_string(cs.sim.procedure), model->n(), max_threads(c)));
   if (!quiet)
     fmt::print("rfem run {}: n = {} rfes{}, m = {} joints, t_end = {} s, {} thread(s) -> {}\n", cs.path, model->n(),
                model->links.size() > 1 ? fmt::format(" in {} links", model->links.size()) : "", model->m(),

@@ -7,7 +7,10 @@
 #include <Eigen/Core>
 #include <sstream>
 
+#include <csignal>
+
 #include "commands.hpp"
+#include "rfem/results/errors.hpp"
 #include "rfem/version.hpp"
 
 namespace {
@@ -33,6 +36,8 @@ const CLI::Validator kPositiveInt(
 
 int main(int argc, char** argv) {
   using namespace rfem::app;
+  rfem::disable_hdf5_exit_cleanup();  // (every results file is closed before main returns)
+  std::signal(SIGXFSZ, SIG_IGN);      // a file size limit (ulimit -f) is a write error, reported, not a kill
   CLI::App app{"rfem: dynamics of manipulators with flexible links by the Rigid Finite Element Method"};
   app.set_version_flag("--version", std::string("rfem ") + rfem::version_string);
   app.require_subcommand(1);

@@ -1,5 +1,6 @@
 #pragma once
-// The program's signal handling: while a SignalStop lives, SIGINT and SIGTERM request a stop of
+// The program's signal handling: while a SignalStop lives, SIGINT, SIGTERM and SIGHUP (a closed
+// terminal) request a stop of
 // its token (the run ends cleanly after the current step, its outputs kept) instead of killing the
 // process; the previous handlers come back when it dies.
 #include <signal.h>
@@ -16,7 +17,7 @@ class SignalStop {
   SignalStop& operator=(const SignalStop&) = delete;
 
  private:
-  struct sigaction old_int_ {}, old_term_{};
+  struct sigaction old_int_ {}, old_term_{}, old_hup_{};
 };
 
 }  // namespace rfem::app

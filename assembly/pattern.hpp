@@ -1,5 +1,5 @@
 #pragma once
-// Storage of the bordered block matrix of the Newton system (FORMULATION.md §4), its upper
+// Storage of the bordered block matrix of the Newton system (docs/formulation.md §4), its upper
 // triangle block by block. The unknowns are 6-blocks (rfes) grouped into *chains* — runs of
 // consecutive blocks, each coupled to its neighbours (the rfes of one link between carrying rfes)
 // — followed by nb *border* coordinates (carrying rfes and unknown joints). Every block of chain c

@@ -1,7 +1,7 @@
 #pragma once
 // Per-rfe kernels. World pose of rfe k: W_k = B0 C_k D_k(q_k) [2.5] with C_k = Trans(centre_k) and
 // B0 the pose of its link's frame {r} (`LinkFrame`). Kinetic energy T_k = ½ tr(Ẇ H Ẇᵀ) [3.6]; the
-// Lagrange term of coordinate j is ε_j = tr(∂W/∂q_j H Ẅᵀ) (FORMULATION.md §3), which gives M a + h in
+// Lagrange term of coordinate j is ε_j = tr(∂W/∂q_j H Ẅᵀ) (docs/formulation.md §3), which gives M a + h in
 // one pass without b-tensors. Rows of the nodes that move {r} (`ancestors`, core/kinematics.hpp) are
 // returned as 4×4 "moment" matrices that the caller contracts with Ξ_j: ε_j = tr(Ξ_j Y),
 // M_jl = tr(Ξ_j G Ξ_lᵀ), gravity g e₃ᵀ Ξ_j s.

@@ -3,7 +3,7 @@
 // Newton matrix, assembly + factorisation (chain solver or CHOLMOD), one solve.
 // Arguments: {n, threads[, solver: 0 chain, 1 CHOLMOD]}.
 // BM_Links*: the cost per rfe of one flexible link of n rfes against two links of n/2 in a row
-// (issue 10 §9): the two-link arm of cases/two_link_arm.toml (shoulder, upper link, elbow on its
+//: the two-link arm of cases/two_link_arm.toml (shoulder, upper link, elbow on its
 // tip, forearm) and the same 2 m strip as one link of two segments on the shoulder. Arguments
 // {n, links: 1 or 2}; one thread. A step is what an ESDIRK5 step costs: one Newton setup and 12
 // residual evaluations with 12 solves.

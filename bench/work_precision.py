@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Work–precision study of rfem's time integrators (issue 9).
+"""Work–precision study of rfem's time integrators.
 
 For each case and n: a converged reference (ESDIRK547L2SA2 at rtol 1e-10, atol 1e-11; a second one
 with ESDIRK43I6L2SA at the same tolerances bounds the reference's own error), then every integrator

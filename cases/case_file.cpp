@@ -71,6 +71,9 @@ Simulation read_simulation(const Reader& r, const toml::table& t) {
   o.t_end = r.positive(t, p, "t_end");
   o.output_dt = r.positive(t, p, "output_dt", std::min(o.output_dt, o.t_end));
   if (o.output_dt > o.t_end) r.fail(t.get("output_dt"), p + ".output_dt", "must not exceed t_end");
+  if (!(o.t_end / o.output_dt <= kMaxOutputs))
+    r.fail(t.get("output_dt"), p + ".output_dt",
+           "t_end / output_dt = " + Reader::fmt(o.t_end / o.output_dt) + " outputs is more than a results file can take (1e8)");
   o.rtol = r.positive(t, p, "rtol", o.rtol);
   o.atol = r.positive(t, p, "atol", o.atol);
   o.atol_velocity = r.positive(t, p, "atol_velocity", o.atol_velocity);
@@ -99,6 +102,11 @@ Simulation read_simulation(const Reader& r, const toml::table& t) {
   if (initial != "static" && initial != "undeformed")
     r.fail(t.get("initial"), p + ".initial", "must be \"static\" or \"undeformed\" (got \"" + initial + "\")");
   o.initial = initial == "static" ? InitialState::Static : InitialState::Undeformed;
+  try {  // what the integrator itself refuses (the one home of those rules)
+    check_options(o);
+  } catch (const std::invalid_argument& e) {
+    r.fail(&t, p, e.what());
+  }
   return s;
 }
 
@@ -227,7 +235,11 @@ Model build_model(const Case& c, int n) {
     for (size_t s = 0; s < parts[l].size(); ++s) link.segments[s].parts = parts[l][s];
     MountedLink ml;
     ml.name = c.links[l].name;
-    ml.d = discretise(link);
+    try {
+      ml.d = discretise(link);
+    } catch (const std::invalid_argument& e) {
+      throw CaseError(c.path + ": " + c.links[l].key + ": " + e.what());
+    }
     ml.on = c.links[l].on;
     links.push_back(std::move(ml));
   }

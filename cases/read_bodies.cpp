@@ -112,7 +112,9 @@ Mat4 read_body(const Reader& r, const toml::table& t, const std::string& path, c
     I(0, 0) = rho * L * (s.Iy + s.Iz);
     I(1, 1) = mass * L * L / 12.0 + rho * L * s.Iy;
     I(2, 2) = mass * L * L / 12.0 + rho * L * s.Iz;
-    return pseudo_inertia(mass, Vec3(0.5 * L, 0, 0), I);
+    const Mat4 H = pseudo_inertia(mass, Vec3(0.5 * L, 0, 0), I);
+    if (!H.allFinite()) r.fail(t.get("length"), path + ".length", "the body's mass and inertia overflow (" + Reader::fmt(mass) + " kg)");
+    return H;
   }
   std::set<std::string> keys{"mass", "com", "inertia"};
   keys.insert(extra.begin(), extra.end());
@@ -136,7 +138,9 @@ Mat4 read_body(const Reader& r, const toml::table& t, const std::string& path, c
         v[1] + v[2] < v[0] || v[0] + v[2] < v[1])
       r.fail(n, path + ".inertia", "is not a physical inertia tensor");
   }
-  return pseudo_inertia(mass, com, I);
+  const Mat4 H = pseudo_inertia(mass, com, I);
+  if (!H.allFinite()) r.fail(&t, path, "the body's mass and inertia overflow");
+  return H;
 }
 
 JointDrive read_drive(const Reader& r, const toml::table& t, const std::string& path) {

@@ -77,6 +77,7 @@ void read_joints(const Reader& r, const toml::table& root, const Materials& mats
                          "parent", "at", "mount"});
     Joint j;
     j.name = r.string(jt, p, "name", "joint" + std::to_string(i + 1));
+    if (const std::string why = name_problem(j.name); !why.empty()) r.fail(jt.get("name"), p + ".name", why);
     const std::string type = r.string(jt, p, "type", std::string("revolute"));
     if (type == "revolute") j.type = JointType::Revolute;
     else if (type == "prismatic") j.type = JointType::Prismatic;

@@ -14,6 +14,7 @@ LinkCase read_link(const Reader& r, const toml::table& lt, const std::string& ke
   LinkCase c;
   c.key = key;
   c.name = r.string(lt, key, "name", name);
+  if (const std::string why = name_problem(c.name); !why.empty()) r.fail(lt.get("name"), key + ".name", why);
   c.n = static_cast<int>(r.integer(lt, key, "n", 0, 1, kMaxRfes));
   c.link.damping_beta = r.non_negative(lt, key, "damping_beta", 0.0);
   parent.path = key;

@@ -4,7 +4,7 @@
 // Ξ_j = W_j Ĝ_j W_j⁻¹ (depends on the coordinates of j's ancestors only), for every body i beyond j
 //   ∂W_i/∂q_j = Ξ_j W_i,  ∂²W_i/∂q_j∂q_l = Ξ_j Ξ_l W_i  (j an ancestor of l, or j = l),
 // so Ẇ = Ω W with Ω = Σ Ξ_j q̇_j, and Ẅ = (Σ Ξ_j q̈_j + Σ_jl Ξ_min Ξ_max q̇_j q̇_l) W over the path
-// from the root (FORMULATION.md §3).
+// from the root (docs/formulation.md §3).
 #include "rfem/core/model.hpp"
 
 namespace rfem {

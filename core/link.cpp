@@ -187,6 +187,17 @@ Discretisation discretise(const FlexibleLink& link) {
     s.eta_right = point - d.rfes[e].centre;
   }
   d.tip_eta = Vec3(d.length, 0.0, 0.0) - d.rfes.back().centre;
+  // What the given values derive must be usable numbers too (1e308 kg/m³ times a volume is not).
+  for (int k = 0; k <= n; ++k) {
+    const Rfe& r = k == 0 ? d.rfe0 : d.rfes[k - 1];
+    if (!r.H.allFinite() || !std::isfinite(r.mass) || !(r.mass > 0.0) || !r.centre.allFinite())
+      throw std::invalid_argument("rfe " + std::to_string(k) + ": its mass or inertia is not a positive finite number "
+                                  "(the segments' values overflow or vanish)");
+  }
+  for (int e = 0; e < n; ++e)
+    if (!d.sdes[e].c.allFinite() || !d.sdes[e].k.allFinite() || !(d.sdes[e].c.minCoeff() > 0.0) || !(d.sdes[e].k.minCoeff() > 0.0))
+      throw std::invalid_argument("sde " + std::to_string(e + 1) + ": its stiffness is not a positive finite number "
+                                  "(the segments' values overflow or vanish)");
   return d;
 }
 

@@ -1,6 +1,6 @@
 #pragma once
 // A flexible link made of segments, and its discretisation into rfes and sdes by the primary and
-// secondary division (FORMULATION.md §2): each segment is cut into equal parts, one sde sits at the
+// secondary division (docs/formulation.md §2): each segment is cut into equal parts, one sde sits at the
 // middle of each part, rfes lie between consecutive sdes. The link axis is x of the frame {r}.
 #include <string>
 #include <vector>

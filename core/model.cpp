@@ -113,6 +113,16 @@ void place_joint(Model& M, int j) {
 
 }  // namespace
 
+std::string name_problem(const std::string& name) {
+  if (name.empty()) return "a name cannot be empty";
+  if (name == "." || name == "..") return "'" + name + "' cannot be a name";
+  for (unsigned char ch : name) {
+    if (ch == '/') return "a name cannot hold '/' (it names a group of the results file)";
+    if (ch < 0x20 || ch == 0x7f) return "a name cannot hold control characters";
+  }
+  return "";
+}
+
 Model make_model(std::vector<Joint> joints, std::vector<MountedLink> links, double gravity, bool free_base) {
   Model M;
   M.joints = std::move(joints);
@@ -132,6 +142,13 @@ Model make_model(std::vector<Joint> joints, std::vector<MountedLink> links, doub
     }
   }
   require_non_negative("gravity", M.gravity);
+  for (int l = 0; l < nl; ++l) {  // link names are paths of results: usable and distinct
+    if (const std::string why = name_problem(M.links[l].name); !why.empty())
+      throw std::invalid_argument(what(M, false, l) + ": " + why);
+    for (int k = 0; k < l; ++k)
+      if (M.links[k].name == M.links[l].name)
+        throw std::invalid_argument(what(M, false, l) + ": another link has the same name");
+  }
   {  // defaults and checks of every mounting (core/mounting.hpp)
     std::vector<Mounting> jon, lon;
     std::vector<std::string> jn, ln;

@@ -1,5 +1,5 @@
 #pragma once
-// The immutable description of a manipulator built once from a case (issue 10 §1): joints and
+// The immutable description of a manipulator built once from a case: joints and
 // flexible links, each mounted on the ground, on a joint's body or on a point of a flexible link,
 // forming a tree; the rigid inertias; every link's rfes and sdes.
 //
@@ -10,7 +10,7 @@
 //
 // Coordinates: q = [rfes that carry nothing, link by link; carrying rfes; joints], 6 per rfe, 1 per
 // joint: the order in which the Newton matrix factorises without fill (the carrying rfes and the
-// joints form the dense border of every link's chain of rfes, FORMULATION.md §4). The model owns
+// joints form the dense border of every link's chain of rfes, docs/formulation.md §4). The model owns
 // this layout: other code asks rfe_index / joint_index instead of computing offsets.
 #include <string>
 
@@ -92,9 +92,14 @@ struct Model {
   }
 };
 
+/// Why `name` cannot name a joint or a link ("" if it can): names become components of results
+/// paths (links/NAME/tip) and prefixes of refinement quantities, so they are non-empty, not "." or
+/// "..", and hold no "/" and no control characters (a NUL would cut them short).
+std::string name_problem(const std::string& name);
+
 /// Builds a model: places every joint and link on what it is mounted on (throws
 /// std::invalid_argument for a bad index, a point off its link or a cycle), adds each link's rfe_0
-/// to the body that carries it (FORMULATION.md §2), numbers the coordinates.
+/// to the body that carries it (docs/formulation.md §2), numbers the coordinates.
 Model make_model(std::vector<Joint> joints, std::vector<MountedLink> links, double gravity, bool free_base = false);
 /// A serial chain of joints with one flexible link on the last one ({r} = `mount` in its frame),
 /// or no link if `link` is empty (no rfes and no length).

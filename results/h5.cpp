@@ -2,6 +2,10 @@
 
 #include <algorithm>
 
+namespace rfem {
+void disable_hdf5_exit_cleanup() { H5dont_atexit(); }
+}  // namespace rfem
+
 namespace rfem::h5 {
 
 Quiet::Quiet() {
@@ -23,6 +27,14 @@ std::string reason() {
   std::string msg;
   H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, innermost, &msg);
   H5Eclear2(H5E_DEFAULT);
+  // A failed system call: HDF5 quotes the system's words ("error message = 'No space left on
+  // device'") inside a long description; those words are the reason.
+  const std::string tag = "error message = '";
+  if (const auto at = msg.find(tag); at != std::string::npos) {
+    const auto end = msg.find('\'', at + tag.size());
+    if (end != std::string::npos) msg = msg.substr(at + tag.size(), end - at - tag.size());
+  }
+  if (const auto nl = msg.find('\n'); nl != std::string::npos) msg.resize(nl);
   return msg.empty() ? "HDF5 error" : msg;
 }
 
@@ -37,6 +49,7 @@ void check(herr_t status, const std::string& what) {
 
 bool Handle::reset() {
   if (id_ < 0) return true;
+  const Quiet quiet;  // (a destructor's close reports nothing: what failed was reported before)
   const bool ok = close_(id_) >= 0;
   id_ = -1;
   return ok;

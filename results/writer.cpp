@@ -1,7 +1,16 @@
 #include "rfem/results/writer.hpp"
 
+#include <fcntl.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/statvfs.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <variant>
 
 #include "rfem/results/h5_impl.hpp"
@@ -23,9 +32,14 @@ h5::Handle latest_fapl() {  // SWMR needs the latest file format
 
 }  // namespace
 
+// Room a run's group needs besides its chunks of rows: metadata flushes, the attributes written at
+// its end, closing the file (measured: a run group's metadata takes 20–40 kB).
+constexpr long long kMargin = 64 * 1024;
+
 struct ResultsWriter::File {
   std::string path;
   h5::Handle id;
+  int lock_fd = -1;  // holds the open-file-description lock that keeps other rfem writers out
   bool swmr = false;
   using Value = std::variant<std::string, double, long>;
   struct Pending {
@@ -35,6 +49,30 @@ struct ResultsWriter::File {
   std::vector<Pending> pending;  // attributes that wait for the end of SWMR mode
 
   std::string what(const std::string& doing) const { return path + ": " + doing; }
+
+  ~File() {
+    if (lock_fd >= 0) ::close(lock_fd);
+  }
+
+  // Refuses (ResultsError) a write of `bytes` more that the disk or the file size limit (ulimit -f)
+  // cannot take. HDF5 cannot recover from a failed write (its file is left unreadable, and its own
+  // clean-up at exit crashes), so writes stop while there is still room to record why.
+  void require(long long bytes) const {
+    const std::string dir = std::filesystem::path(path).parent_path().string();
+    struct statvfs fs {};
+    if (statvfs(dir.empty() ? "." : dir.c_str(), &fs) == 0) {
+      const long long free = static_cast<long long>(fs.f_bavail) * static_cast<long long>(fs.f_frsize);
+      if (free < bytes)
+        throw ResultsError("cannot write " + path + ": the disk is full (" + std::to_string(free / 1024) + " kB free, " +
+                           std::to_string(bytes / 1024) + " kB needed for the next rows)");
+    }
+    struct rlimit rl {};
+    struct stat st {};
+    if (getrlimit(RLIMIT_FSIZE, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY && ::stat(path.c_str(), &st) == 0 &&
+        static_cast<long long>(st.st_size) + bytes > static_cast<long long>(rl.rlim_cur))
+      throw ResultsError("cannot write " + path + ": the file size limit (ulimit -f, " + std::to_string(rl.rlim_cur / 1024) +
+                         " kB) is reached");
+  }
 
   void attribute(const std::string& object, const std::string& key, const Value& value) {
     if (swmr) {
@@ -74,9 +112,44 @@ struct ResultsWriter::File {
   }
 };
 
+namespace {
+
+// What may not be overwritten: the case itself, a file that is not HDF5, a file another rfem run
+// writes. Returns the descriptor that holds the lock (an open-file-description lock far beyond the
+// file's data: HDF5's own locks are flock()s, which SWMR writing drops, and readers take none).
+int claim(const std::string& path, const std::string& case_path) {
+  std::error_code ec;
+  if (!case_path.empty() && std::filesystem::exists(path, ec) && std::filesystem::equivalent(path, case_path, ec))
+    throw ResultsError(path + ": is the case file: results would overwrite it (choose another -o)");
+  if (std::filesystem::is_directory(path, ec)) throw ResultsError(path + ": is a directory, not a results file");
+  if (std::filesystem::exists(path, ec) && std::filesystem::file_size(path, ec) > 0 && H5Fis_hdf5(path.c_str()) <= 0) {
+    h5::reason();
+    throw ResultsError(path + ": exists and is not an HDF5 file: not overwritten (remove it, or choose another -o)");
+  }
+  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) throw ResultsError(path + ": cannot create results file (" + std::strerror(errno) + ")");
+  struct flock lk {};
+  lk.l_type = F_WRLCK;
+  lk.l_whence = SEEK_SET;
+  lk.l_start = 1LL << 62;  // a byte no HDF5 file reaches
+  lk.l_len = 1;
+  if (fcntl(fd, F_OFD_SETLK, &lk) != 0) {
+    const int err = errno;
+    ::close(fd);
+    if (err == EAGAIN || err == EACCES)
+      throw ResultsError(path + ": another rfem run is writing this file (choose another -o, or wait for it)");
+    throw ResultsError(path + ": cannot lock the results file (" + std::strerror(err) + ")");
+  }
+  return fd;
+}
+
+}  // namespace
+
 ResultsWriter::ResultsWriter(const std::string& path, const FileDescription& d) : file_(std::make_shared<File>()) {
   const h5::Quiet quiet;
   file_->path = path;
+  file_->lock_fd = claim(path, d.case_path);
+  file_->require(kMargin);
   const h5::Handle fapl = latest_fapl();
   file_->id = h5::file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl),
                        path + ": cannot create results file (is the directory writable?)");
@@ -170,13 +243,23 @@ struct RunWriter::Impl {
   struct Series {
     h5::Handle dset;
     int cols = 1;
+    long chunk_rows = 1;
     std::string name;
   };
   std::vector<Series> series, flexible;
   h5::Handle group, status;
   long rows = 0, flex_rows = 0;
   double last_flush = 0.0;
+  long long unflushed = 0;  // bytes of chunks started since the last flush
   std::vector<std::vector<double>> scratch;
+
+  // File space the rows `row` of these series will allocate: a new chunk for each that starts one.
+  static long long new_chunks(const std::vector<Series>& v, long row) {
+    long long bytes = 0;
+    for (const Series& s : v)
+      if (row % s.chunk_rows == 0) bytes += static_cast<long long>(s.chunk_rows) * s.cols * static_cast<long long>(sizeof(double));
+    return bytes;
+  }
 
   std::string what(const std::string& doing) const { return file->what(doing + " " + name); }
 
@@ -196,6 +279,7 @@ struct RunWriter::Impl {
     h5::write_attribute(s.dset, "units", info.units);
     if (!info.description.empty()) h5::write_attribute(s.dset, "description", info.description);
     s.cols = info.width();
+    s.chunk_rows = static_cast<long>(chunk[0]);
     s.name = info.name;
     return s;
   }
@@ -229,6 +313,7 @@ struct RunWriter::Impl {
     }
     file->flush();
     last_flush = now_s();
+    unflushed = 0;
   }
 
   // Closes the datasets and the group (before the file leaves SWMR mode); never throws.
@@ -260,6 +345,7 @@ std::unique_ptr<RunWriter> ResultsWriter::begin_run(const std::string& name, std
   const h5::Quiet quiet;
   File& f = *file_;
   f.end_swmr();  // a new group: not while another run's SWMR lasts
+  f.require(2 * kMargin);
   auto p = std::make_unique<RunWriter::Impl>();
   RunWriter::Impl& w = *p;
   w.file = file_;
@@ -330,9 +416,15 @@ void RunWriter::append(const OutputSample& s) {
   const h5::Quiet quiet;
   Impl& w = *impl_;
   if (!w.group.valid()) throw std::logic_error("RunWriter::append after finish");
+  const bool flexible = !w.flexible.empty() && w.rows % w.layout.flexible_every == 0;
+  // The chunks these rows start, and those started since the last flush (still in HDF5's cache,
+  // written to the file at the next flush), must fit.
+  const long long fresh = Impl::new_chunks(w.series, w.rows) + (flexible ? Impl::new_chunks(w.flexible, w.flex_rows) : 0);
+  w.file->require(kMargin + w.unflushed + fresh);
+  w.unflushed += fresh;
   sample_rows(*w.model, w.layout, s, w.scratch);
   for (size_t i = 0; i < w.series.size(); ++i) w.write_row(w.series[i], w.rows, w.scratch[i].data());
-  if (!w.flexible.empty() && w.rows % w.layout.flexible_every == 0) {
+  if (flexible) {
     flexible_rows(*w.model, w.layout, s, w.scratch);
     for (size_t i = 0; i < w.flexible.size(); ++i) w.write_row(w.flexible[i], w.flex_rows, w.scratch[i].data());
     ++w.flex_rows;

@@ -1,12 +1,11 @@
 #!/usr/bin/env bash
-# Installs the dependencies (Debian 12, root), builds rfem and runs the main examples:
-# the paper's deployment and its figures, the two-link flexible arm, Kane's beam modes and
-# refinement, the paper's link 3 modes, and a static tip load.
+# Installs the dependencies (Debian 12, root), builds and installs rfem (program, library, Python
+# module) and runs the main examples: the paper's deployment and its figures, the two-link flexible
+# arm, Kane's beam modes and refinement, the paper's link 3 modes, a static tip load, and the same
+# arm from Python.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build -j "$(nproc)"
+bash scripts/build.sh rfem _rfem
 set -x
 build/apps/rfem run cases/paper_deployment.toml -o paper_deployment.h5
 build/apps/rfem plot paper_deployment.h5 -o figures
@@ -17,3 +16,4 @@ build/apps/rfem refine cases/kane_beam.toml --n 5,10,20,40,80 --quantity bending
 build/apps/rfem static cases/kane_beam.toml
 build/apps/rfem modes cases/paper_link3.toml --n 60 --count 8
 build/apps/rfem modes cases/kane_spinup.toml --rate 6 --count 4
+/usr/bin/python3 examples/ex5_two_link_pd.py

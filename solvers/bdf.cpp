@@ -151,7 +151,7 @@ RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, S
       return out;
     }
   } catch (const std::exception& e) {
-    out.status = RunStatus::failed(std::string(e.what()) + " at the start (t = 0)");
+    out.status = RunStatus::failed(at_start(e.what()));
     return out;
   }
 

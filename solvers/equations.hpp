@@ -1,5 +1,5 @@
 #pragma once
-// The equations of motion over the unknown coordinates (FORMULATION.md §5): the 6n rfe
+// The equations of motion over the unknown coordinates (docs/formulation.md §5): the 6n rfe
 // coordinates and the joints under force input. With full q, v, a built from the unknowns and the
 // laws of prescribed joints,
 //   r_u(t, q_u, v_u, a_u) = F_u(q, v, a) − τ_u(t),   F = M(q) a + h(q, v) + f_el + f_g + f_d,

@@ -148,7 +148,7 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
     a = eq.accelerations(0.0, q.data(), v.data());
     P = eq.residual(0.0, q.data(), v.data(), a.data(), r.data());
   } catch (const std::exception& e) {
-    out.status = RunStatus::failed(std::string(e.what()) + " at the start (t = 0)");
+    out.status = RunStatus::failed(at_start(e.what()));
     return out;
   }
   ++st.residual_evals;
@@ -162,7 +162,7 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
     try {
       s0 = eq.sample(0.0, q.data(), v.data(), a.data(), 0.0, 0.0);
     } catch (const std::exception& e) {
-      out.status = RunStatus::failed(std::string(e.what()) + " at the start (t = 0)");
+      out.status = RunStatus::failed(at_start(e.what()));
       return out;
     }
     if (!emit(s0)) {
@@ -202,6 +202,7 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
   const int max_newton = o.fixed_step > 0 ? 60 : kMaxNewton;
   double t = 0.0, err_prev = 1.0, eta = 1.0;
   bool last_rejected = false;
+  bool nonfinite = false;  // a residual or an error estimate was NaN or inf since the last accepted step
   const std::vector<double> breaks = eq.breakpoints(o.t_end);
   size_t next_break = 0;
   const long n_out = output_count(o);
@@ -242,9 +243,11 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
         return fail("more than " + std::to_string(o.max_steps) + " steps in one output interval");
       // Rejected attempts count too: a step that never converges must not retry for ever.
       if (attempts_this_output > 10 * o.max_steps + 100)
-        return fail(std::to_string(attempts_this_output) + " rejected step attempts in one output interval");
+        return fail(nonfinite ? "non-finite values (NaN or inf) in the equations"
+                              : std::to_string(attempts_this_output) + " step attempts in one output interval");
       ++attempts_this_output;
-      if (!(h >= 1e-14 * std::max(1.0, t))) return fail(std::isfinite(h) ? "step size underflow" : "the step size is not finite");
+      if (!(h >= 1e-14 * std::max(1.0, t)))
+        return fail(nonfinite || !std::isfinite(h) ? "non-finite values (NaN or inf) in the equations" : "step size underflow");
       // Land exactly on the next breakpoint of the inputs and on t_end; stretch a step that would
       // leave a sliver.
       while (next_break < breaks.size() && breaks[next_break] <= t * (1 + 1e-14)) ++next_break;
@@ -280,7 +283,10 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
           Ps[i] = eq.residual(ti, Q.data(), V.data(), alpha[i].data(), r.data());
           ++st.residual_evals;
           ++st.newton_iters;
-          if (!r.allFinite()) break;
+          if (!r.allFinite()) {
+            nonfinite = true;
+            break;
+          }
           eq.solve_newton(r);
           r = -r;  // δα
           alpha[i] += r;
@@ -324,6 +330,7 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
       const double err = std::max(wrms(eqv, evv, w), 1e-10);
       const double expo = 1.0 / (T.embedded_order + 1);
       if (!std::isfinite(err) || !q1.allFinite() || !v1.allFinite()) {  // NaN passes no test: cut the step
+        nonfinite = true;
         ++st.newton_fails;
         if (o.fixed_step > 0) return fail("the solution is not finite with the fixed step");
         h *= 0.25;
@@ -395,7 +402,7 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
       double fac = kSafety * std::pow(err, -0.7 * expo) * std::pow(err_prev, 0.4 * expo);
       fac = std::clamp(fac, kMinFactor, last_rejected ? 1.0 : kMaxFactor);
       err_prev = err;
-      last_rejected = false;
+      last_rejected = nonfinite = false;
       h = o.fixed_step > 0 ? o.fixed_step : h * fac;
       if (o.max_step > 0) h = std::min(h, o.max_step);
     }

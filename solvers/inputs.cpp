@@ -1,6 +1,9 @@
 #include "rfem/solvers/inputs.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cstdlib>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -11,6 +14,9 @@
 namespace rfem {
 
 namespace {
+
+// Tables of more rows than this force no step ends at their nodes.
+constexpr size_t kMaxTableBreakpoints = 1000;
 
 // A table's columns: of equal length, finite.
 void check_table(const std::vector<double>& t, const std::vector<double>& v) {
@@ -28,6 +34,7 @@ class Deployment : public MotionLaw {
     require_finite("deployment: the initial value", psi0);
     require_finite("deployment: alpha", alpha);
     require_positive("deployment: T", T);
+    require_finite("deployment: its rate pi alpha / 2T", k_);
   }
   MotionSample at(double t) const override {
     if (t >= T_) return {psi0_ - k_ * T_, 0.0, 0.0};
@@ -46,6 +53,7 @@ class Spinup : public MotionLaw {
     require_finite("spinup: the initial value", th0);
     require_finite("spinup: Omega", Omega);
     require_positive("spinup: T", T);
+    require_finite("spinup: its acceleration Omega / T", Omega / T);
   }
   MotionSample at(double t) const override {
     if (t >= T_) return {th0_ + W_ * (t - T_ / 2), W_, 0.0};
@@ -109,7 +117,9 @@ class Spline : public MotionLaw {
     s.qdd = A * m_[i - 1] + B * m_[i];
     return s;
   }
-  std::vector<double> breakpoints() const override { return t_; }  // the third derivative jumps at nodes
+  // The third derivative jumps at the nodes; steps end there unless a table is so dense that the
+  // forced ends would cost more than the error control that follows the jumps anyway.
+  std::vector<double> breakpoints() const override { return t_.size() <= kMaxTableBreakpoints ? t_ : std::vector<double>{}; }
 
  private:
   std::vector<double> t_, q_, m_;
@@ -139,7 +149,9 @@ class LinearTorque : public TorqueLaw {
     const double w = (t - t_[i - 1]) / (t_[i] - t_[i - 1]);
     return (1 - w) * v_[i - 1] + w * v_[i];
   }
-  std::vector<double> breakpoints() const override { return t_; }  // kinks at the nodes
+  std::vector<double> breakpoints() const override {  // kinks at the nodes (a dense table: see Spline)
+    return t_.size() <= kMaxTableBreakpoints ? t_ : std::vector<double>{};
+  }
 
  private:
   std::vector<double> t_, v_;
@@ -225,23 +237,57 @@ std::shared_ptr<TorqueLaw> torque_function(std::function<double(double)> f, std:
 }
 
 void read_csv_series(const std::string& path, std::vector<double>& t, std::vector<double>& v) {
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open tabulated input");
   t.clear();
   v.clear();
+  auto where = [&](int ln) { return path + ":" + std::to_string(ln) + ": "; };
+  // A field is a number only if strtod takes all of it ("1OO" is not 100).
+  auto number = [](const std::string& f, double& x) {
+    if (f.empty()) return false;
+    char* end = nullptr;
+    errno = 0;
+    x = std::strtod(f.c_str(), &end);
+    return end == f.c_str() + f.size() && errno != ERANGE;
+  };
+  bool seen_content = false;
   std::string line;
   for (int ln = 1; std::getline(in, line); ++ln) {
+    if (ln == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // a UTF-8 byte-order mark
     const auto hash = line.find('#');
     if (hash != std::string::npos) line.resize(hash);
+    // Fields: separated by commas (white space around them ignored), or by white space alone.
+    std::vector<std::string> fields;
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    std::replace(line.begin(), line.end(), ',', ' ');
-    std::istringstream ss(line);
-    double a, b;
-    if (!(ss >> a >> b)) {
-      if (t.empty() && v.empty() && ln <= 2) continue;  // a header line
-      throw std::runtime_error(path + ":" + std::to_string(ln) + ": expected two numbers 'time, value'");
+    if (line.find(',') != std::string::npos) {
+      std::stringstream ss(line);
+      for (std::string f; std::getline(ss, f, ',');) {
+        const auto x = f.find_first_not_of(" \t\r"), y = f.find_last_not_of(" \t\r");
+        fields.push_back(x == std::string::npos ? std::string() : f.substr(x, y - x + 1));
+      }
+      if (line.back() == ',') fields.emplace_back();  // (getline drops a last empty field)
+    } else {
+      std::istringstream ss(line);
+      for (std::string f; ss >> f;) fields.push_back(f);
     }
-    if (!std::isfinite(a) || !std::isfinite(b)) throw std::runtime_error(path + ":" + std::to_string(ln) + ": not finite");
+    // The first content line may be a header: words only, no field that starts like a number.
+    if (!seen_content) {
+      seen_content = true;
+      const bool words = std::all_of(fields.begin(), fields.end(), [](const std::string& x) {
+        return !x.empty() && !std::isdigit(static_cast<unsigned char>(x[0])) && x[0] != '-' && x[0] != '+' && x[0] != '.';
+      });
+      if (words) continue;
+    }
+    if (fields.size() != 2)
+      throw std::runtime_error(where(ln) + "expected two numbers 'time, value' (got " + std::to_string(fields.size()) + " fields)");
+    double a = 0.0, b = 0.0;
+    for (int k = 0; k < 2; ++k)
+      if (!number(fields[k], k == 0 ? a : b))
+        throw std::runtime_error(where(ln) + "expected two numbers 'time, value' ('" + fields[k] + "' is not a number)");
+    if (!std::isfinite(a) || !std::isfinite(b)) throw std::runtime_error(where(ln) + "not finite");
+    if (!t.empty() && !(a > t.back()))
+      throw std::runtime_error(where(ln) + "the times must increase (" + std::to_string(a) + " s after " +
+                               std::to_string(t.back()) + " s)");
     t.push_back(a);
     v.push_back(b);
   }

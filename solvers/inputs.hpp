@@ -36,7 +36,7 @@ class TorqueLaw {
   virtual std::vector<double> breakpoints() const { return {}; }
 };
 
-/// Kane's deployment law (the dimensionally consistent form, FORMULATION.md §3):
+/// Kane's deployment law (the dimensionally consistent form, docs/formulation.md §3):
 /// ψ(t) = ψ0 − (π α/(2T)) (t − (T/2π) sin(2πt/T)) for t ≤ T, then ψ0 − π α/2.
 std::shared_ptr<MotionLaw> deployment_law(double psi0, double alpha, double T);
 /// Kane's spin-up law: θ = θ0 + (Ω/T)(t²/2 + (T/2π)²(cos(2πt/T) − 1)) for t ≤ T, then θ0 + Ω(t − T/2).
@@ -54,7 +54,7 @@ std::shared_ptr<TorqueLaw> tabulated_torque(std::vector<double> t, std::vector<d
 /// earlier run); t outside the table is an error.
 std::shared_ptr<TorqueLaw> spline_torque(std::vector<double> t, std::vector<double> tau);
 /// Any callable τ(t), smooth except at the given times.
-/// PD feedback on a reference motion with an optional feed-forward torque (issue 10 §6):
+/// PD feedback on a reference motion with an optional feed-forward torque:
 ///   τ = τ_ff(t) + k_p (q_ref(t) − q) + k_d (q̇_ref(t) − q̇).
 /// With the rigid manipulator's inverse dynamics of the references as τ_ff (computed torque) the
 /// feedback only corrects what the link's flexibility adds. kp, kd ≥ 0; ff may be null.

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "rfem/core/check.hpp"
@@ -58,8 +59,23 @@ RunOutcome inverse_dynamics_only(EquationsOfMotion& eq, const IntegratorOptions&
 SampleEmitter::SampleEmitter(const SampleSink& sink, const RunControl& control)
     : sink_(sink), control_(control), last_beat_(now_s()) {}
 
+namespace {
+bool finite(const OutputSample& s) {
+  const Energies& e = s.energy;
+  return s.q.allFinite() && s.v.allFinite() && s.a.allFinite() && s.tau.allFinite() && std::isfinite(e.kinetic) &&
+         std::isfinite(e.elastic) && std::isfinite(e.gravity) && std::isfinite(s.dissipated) && std::isfinite(s.input_work) &&
+         s.momentum.linear.allFinite() && s.momentum.angular.allFinite();
+}
+}  // namespace
+
 bool SampleEmitter::operator()(const OutputSample& s) {
   if (failed()) return false;
+  if (!finite(s)) {  // NaN or inf never reaches a results file as if it were a result
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "non-finite values (NaN or inf) in the outputs at t = %.6g s; check the inputs' values", s.t);
+    error_ = buf;
+    return false;
+  }
   try {
     if (sink_) sink_(s);
   } catch (const std::exception& e) {
@@ -84,6 +100,10 @@ bool SampleEmitter::beat(double t, long steps) {
     error_ = "the heartbeat threw an unknown exception";
   }
   return !failed();
+}
+
+std::string at_start(const std::string& why) {
+  return why.find("t = ") == std::string::npos ? why + " at the start (t = 0)" : why;
 }
 
 std::string integrator_name(IntegratorKind k) { return k == IntegratorKind::Bdf ? "bdf" : "esdirk"; }

@@ -1,5 +1,5 @@
 #pragma once
-// Time integration of  q' = v,  M(q) v' + h(q, v) + f_el + f_g + f_d = τ  (FORMULATION.md §5) over
+// Time integration of  q' = v,  M(q) v' + h(q, v) + f_el + f_g + f_d = τ  (docs/formulation.md §5) over
 // the unknown coordinates: the 6n rfe coordinates and the joints under force input. Joints under
 // kinematic input follow their laws; their torques come out of the base rows (inverse dynamics).
 // The dissipated energy and the input work are integrated alongside.
@@ -129,6 +129,9 @@ RunEstimate estimate_run(std::shared_ptr<const Model> model, const std::vector<J
 class SampleEmitter;
 RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& opts, SampleEmitter& emit);
 RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, SampleEmitter& emit);
+
+/// The reason of a failure at the start of a run, with its time if it does not say one.
+std::string at_start(const std::string& why);
 
 /// Delivers samples to the caller's sink and heartbeat, catching what they throw: a failing sink
 /// or heartbeat ends the run (failed, with its message) instead of unwinding through the

@@ -56,8 +56,17 @@ std::shared_ptr<TorqueLaw> torque_from_results(const InputSpec& in, int joint, d
   return spline_torque(times, values);
 }
 
+// A table's rows, which must cover the run (0 … t_end): tables are never extrapolated.
+void read_table(const InputSpec& in, double t_end, std::vector<double>& t, std::vector<double>& v) {
+  read_csv_series(in.file, t, v);
+  if (t.front() > 0.0 || t.back() < t_end * (1 - 1e-12))
+    throw CaseError(in.where + ".file: '" + in.file + "' covers t = " + fmt::format("{}", t.front()) + " … " +
+                    fmt::format("{}", t.back()) + " s; the run needs 0 … " + fmt::format("{}", t_end) +
+                    " s (a table is not extrapolated)");
+}
+
 // A prescribed motion of one of the motion kinds, starting from the joint's value q0.
-std::shared_ptr<MotionLaw> motion_law(const InputSpec& in, double q0) {
+std::shared_ptr<MotionLaw> motion_law(const InputSpec& in, double q0, double t_end) {
   switch (in.kind) {
     case InputKind::Deployment: return deployment_law(q0, in.alpha, in.T);
     case InputKind::Spinup: return spinup_law(q0, in.Omega, in.T);
@@ -65,7 +74,7 @@ std::shared_ptr<MotionLaw> motion_law(const InputSpec& in, double q0) {
     default: break;
   }
   std::vector<double> t, q;
-  read_csv_series(in.file, t, q);
+  read_table(in, t_end, t, q);
   return tabulated_motion(t, q);
 }
 
@@ -84,6 +93,7 @@ std::vector<JointInput> joint_inputs(const Case& cs, const Warnings& warn) {
   std::vector<JointInput> out(cs.joints.size());
   std::vector<std::shared_ptr<MotionLaw>> reference(cs.joints.size());  // of PD joints
   bool rigid_ff = false;
+  const double t_end = cs.has_simulation ? cs.sim.options.t_end : 0.0;
   for (size_t j = 0; j < cs.joints.size(); ++j) {
     const InputSpec& in = cs.inputs[j];
     const double q0 = cs.joint_values[static_cast<long>(j)], v0 = cs.joint_rates[static_cast<long>(j)];
@@ -91,16 +101,16 @@ std::vector<JointInput> joint_inputs(const Case& cs, const Warnings& warn) {
     ji.q0 = q0;
     ji.v0 = v0;
     try {
-      if (in.prescribed()) ji.motion = motion_law(in, q0);
+      if (in.prescribed()) ji.motion = motion_law(in, q0, t_end);
       else if (in.kind == InputKind::Torque) ji.torque = constant_torque(in.value);
       else if (in.kind == InputKind::TorqueTable) {
         std::vector<double> t, tau;
-        read_csv_series(in.file, t, tau);
+        read_table(in, t_end, t, tau);
         ji.torque = tabulated_torque(t, tau);
       } else if (in.kind == InputKind::TorqueFromRun) {
-        ji.torque = torque_from_results(in, static_cast<int>(j), cs.has_simulation ? cs.sim.options.t_end : 0.0, warn);
+        ji.torque = torque_from_results(in, static_cast<int>(j), t_end, warn);
       } else if (in.kind == InputKind::Pd) {
-        reference[j] = motion_law(*in.reference, q0);
+        reference[j] = motion_law(*in.reference, q0, t_end);
         ji.torque = pd_law(reference[j], in.kp, in.kd, nullptr);
         rigid_ff |= in.feedforward == Feedforward::Rigid;
       }

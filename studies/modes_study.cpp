@@ -83,6 +83,10 @@ ModesStudy modes_study(const Case& cs, const ModesRequest& rq) {
     ref.theory = bending ? "Timoshenko" : "rod";
     ref.relative_error = (s.frequency_hz(i) - ref.reference_hz) / ref.reference_hz;
     if (bending) ref.euler_bernoulli_hz = beam::cantilever_omega(sg, kind, k) / (2 * M_PI);
+    if (!(ref.reference_hz > 0.0) || !std::isfinite(ref.reference_hz) || !std::isfinite(ref.relative_error))
+      throw std::runtime_error(fmt::format("mode {}: {:g} Hz against a reference of {:g} Hz: the case's values are out of "
+                                           "range (check the units of E, G, rho and the section)",
+                                           i + 1, s.frequency_hz(i), ref.reference_hz));
     s.reference.push_back(ref);
   }
   for (int i = 0; i < s.count; ++i)

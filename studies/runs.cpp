@@ -92,7 +92,12 @@ RunResult run_one(const std::string& name, std::shared_ptr<const Model> model, c
   control.heartbeat_interval = rq.progress_interval;
   if (rq.progress) control.heartbeat = [&](double t, long steps) { rq.progress({name, t, o.t_end, steps}); };
   const auto t0 = std::chrono::steady_clock::now();
-  const RunOutcome r = integrate(model, inputs, o, sink, control);
+  RunOutcome r;
+  try {
+    r = integrate(model, inputs, o, sink, control);
+  } catch (const std::exception& e) {  // (bad options or inputs): the run's record says why
+    r.status = RunStatus::failed(e.what());
+  }
   s.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   s.status = r.status;
   s.stats = r.stats;

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Several flexible links from the command line (issue 10 §7): per-link summaries, JSON and HDF5
+# Several flexible links from the command line: per-link summaries, JSON and HDF5
 # datasets (the top-level ones soft links to the last link's), the elbow joint riding on the upper
 # link's tip, tip loads on a chosen link, link-named refine quantities, a freed wrist, plots of every
 # link, and the paper procedure with two flexible links.

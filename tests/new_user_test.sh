@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# What a new user trips over (issue 11), each as the command that showed it: a results file that
+# What a new user trips over, each as the command that showed it: a results file that
 # describes its own run; command-line errors as one line with exit 2 (and global options after the
 # command); a directory given as a case; plausibility warnings; degrees; a capped --count; plot
 # errors that blame the right path; a run that can be watched (HDF5 SWMR) with strings, integers

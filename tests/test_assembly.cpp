@@ -1,5 +1,5 @@
 // The sparse bordered assembly equals the dense reference built from the paper's definitions
-// ([3.10]–[3.11], every body and coordinate), with 1 and 2 threads (FORMULATION.md §7 invariant 9);
+// ([3.10]–[3.11], every body and coordinate), with 1 and 2 threads (docs/formulation.md §7 invariant 9);
 // the CHOLMOD solve equals a dense solve. Both sides are computed in double precision from the
 // same kernels' inputs, so they agree to round-off (1e-12 relative).
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Cantilever convergence (FORMULATION.md §7 invariants 5 and 6): bending frequencies in both
+// Cantilever convergence (docs/formulation.md §7 invariants 5 and 6): bending frequencies in both
 // planes, axial and torsional frequencies, static tip deflection and rotation converge to exact
 // beam theory with observed order ≈ 2. Kane's beam, with Iz raised to 3e-7 m⁴ so that the two
 // bending planes are distinct.
@@ -61,7 +61,7 @@ TEST(Cantilever, BendingFrequenciesConvergeWithOrderTwoInBothPlanes) {
 }
 
 TEST(Cantilever, TipPayloadMatchesTheTipMassFrequencyEquation) {
-  // cases/kane_tip_mass.toml (issue 10 §4, §8): a 6 kg end effector (μ = M/ρAL = 0.5) with 1.2 kg m²
+  // cases/kane_tip_mass.toml: a 6 kg end effector (μ = M/ρAL = 0.5) with 1.2 kg m²
   // about its centre on the tip (η = J/ρAL³ = 1e-3), Iz raised as above. Its bending frequencies
   // converge with order 2 to the Euler–Bernoulli cantilever with tip mass and rotary inertia, up to
   // the same Timoshenko bound as the free cantilever's (the payload adds no shear of its own).

@@ -1,4 +1,4 @@
-// Time integration (FORMULATION.md §7 invariants 3, 4, 7, 9): energy is conserved without damping,
+// Time integration (docs/formulation.md §7 invariants 3, 4, 7, 9): energy is conserved without damping,
 // gravity or input, and the balance T + V + dissipated − input work closes with them; angular
 // momentum about a free vertical joint is conserved; torques of a kinematic-input run applied as
 // force input reproduce the prescribed motion; 1 and 2 threads agree; the Schur/CHOLMOD Newton solve
@@ -290,7 +290,7 @@ TEST(Dynamics, SchurSolveEqualsDenseSolveOfFullNewtonSystem) {
 TEST(Dynamics, StaticInitialStateStartsInEquilibrium) {
   // Joints held still under gravity: started in static equilibrium (the default) the link does not
   // move and the holding torques are constant; started undeformed it falls into a vibration whose
-  // torque spike at t = 0 grows with n (issue 11: 595 N m against ~60 N m on a two-joint arm).
+  // torque spike at t = 0 grows with n (it reached 595 N m against ~60 N m on a two-joint arm).
   const Model m = test::spatial_arm(12);
   std::vector<JointInput> hold{law(constant_rate_law(0.3, 0.0)), law(constant_rate_law(-0.4, 0.0))};
   auto span = [&](InitialState init, double& dq, double& dtau) {

@@ -1,6 +1,6 @@
 // The time integrators themselves: the ESDIRK methods reach their design order on a smooth problem
 // (soft links: every mode resolved by the steps); the default tolerances keep the integration
-// error of the paper's case below the 1e-4 target (issue 9); the thread governor picks the faster
+// error of the paper's case below the 1e-4 target; the thread governor picks the faster
 // team and keeps checking.
 #include <gtest/gtest.h>
 
@@ -77,7 +77,7 @@ TEST(Integrator, EsdirkReachesItsDesignOrder) {
 TEST(Integrator, DefaultTolerancesMeetTheAccuracyTarget) {
   // The paper's deployment at n = 6, first 5 s: at the default settings the tip deflections, the
   // torsion and the joint-3 torque (kinematic input) and the tip series (force input) are within
-  // 1e-4 of their peaks of a run at rtol 1e-10 (issue 9's target; that run's own error is ~1e-6).
+  // 1e-4 of their peaks of a run at rtol 1e-10 (the accuracy the defaults promise; that run's own error is ~1e-6).
   const Case c = read_case(test::source_path("cases/paper_deployment.toml"), {"simulation.t_end=5"});
   const Model flex = build_model(c, 6), rigid = rigidify(flex);
   const auto laws = joint_inputs(c);

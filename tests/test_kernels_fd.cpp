@@ -1,4 +1,4 @@
-// Finite-difference checks of every kernel's derivatives (FORMULATION.md §7 invariants 1 and 2):
+// Finite-difference checks of every kernel's derivatives (docs/formulation.md §7 invariants 1 and 2):
 // M against the kinetic energy, the inertial force against Lagrange's equations, sde and gravity
 // forces against their energies, stiffness and damping matrices against the forces.
 // Central differences with step h have truncation error ~h²·|f'''| and round-off ~ε|f|/h; with
@@ -195,7 +195,7 @@ TEST(KernelsFD, DampingMatrixIsJacobianOfDampingForces) {
 }
 
 TEST(KernelsFD, JointDrivesAreConsistent) {
-  // Rotor inertia, viscous damping and tanh-smoothed Coulomb friction on every joint (issue 10 §6):
+  // Rotor inertia, viscous damping and tanh-smoothed Coulomb friction on every joint:
   // M is still the Hessian of the kinetic energy (with ½ J q̇²), C the Jacobian of the dissipative
   // forces (friction's slope F_c/v_s sech² included), the dissipated power q̇ · f_d, and the drive's
   // generalised force J q̈ + c q̇ + F_c tanh(q̇/v_s) lands in the joint's row only. v_s = 0.3 rad/s

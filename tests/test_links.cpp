@@ -1,4 +1,4 @@
-// Several flexible links (issue 10 §1–3, §8): a link mounted on another's tip through a locked
+// Several flexible links: a link mounted on another's tip through a locked
 // joint is the same beam as one link of the combined length; the two-link flexible arm conserves
 // energy (and friction accounts for the loss), its kinematic torques reproduce its motion as force
 // input, on a free bus it keeps momentum and centre of mass, and its frequencies converge at
@@ -130,7 +130,7 @@ TEST(Links, TwoLinkArmConservesEnergyAndFrictionAccountsForTheLoss) {
 }
 
 TEST(Links, KinematicTorquesAsForceInputReproduceTheMotionOfTwoFlexibleLinks) {
-  // FORMULATION.md §7 invariant 7 on the two-link arm (both links flexible, the elbow on the upper
+  // docs/formulation.md §7 invariant 7 on the two-link arm (both links flexible, the elbow on the upper
   // link's tip): the torques of a kinematic-input run, as a cubic spline through 1 kHz samples,
   // drive the arm back along the prescribed motion. Drives without friction (its tanh makes the
   // torque kink at rest); sde damping β = 1e-4 s as in the case. Both runs' errors (rtol 1e-9)
@@ -209,7 +209,7 @@ TEST(Links, FrequenciesOfATreeConvergeAtSecondOrder) {
 }
 
 TEST(Links, OneLinkAtTheEndOfTheChainIsAsBeforeTopologies) {
-  // No regression (issue 10 §8): one flexible link at the end of a serial chain — the paper's
+  // No regression: one flexible link at the end of a serial chain — the paper's
   // deployment (kinematic input, n = 6) and the same arm on a free bus — against values printed by
   // rfem 4a88975, before links and joints could be mounted on one another. On the machine that made
   // them they are equal to the last bit; the bound, 1e-6 of each series' peak, leaves room for other

@@ -12,7 +12,7 @@ std::string source_path(const std::string& rel);
 /// rigid links, carrying a two-segment link with an offset mass centre, n rfes, gravity on.
 /// `stiffness` scales E and G (soft links: every mode slow, for temporal-order tests).
 Model spatial_arm(int n, double beta = 0.0, double stiffness = 1.0);
-/// A tree of every kind of mounting (issue 10 §1–4), gravity on: joint 1 (about z, on the ground)
+/// A tree of every kind of mounting, gravity on: joint 1 (about z, on the ground)
 /// carries flexible link A (two segments, offset mass centre, a tip payload); joint 2 sits on A's
 /// tip (a turned mount) and carries link B; a wrist joint 3 (about x) with an end-effector body sits
 /// on B's tip; a prismatic joint 4 with a slider body rides on B at 0.4 of its length; link C is

@@ -1,4 +1,4 @@
-// The rigid manipulator is the case n = 0 (FORMULATION.md §7 invariant 8): inverse dynamics of one-
+// The rigid manipulator is the case n = 0 (docs/formulation.md §7 invariant 8): inverse dynamics of one-
 // and two-link arms against closed-form torques, and a flexible link held undeformed acts on the
 // base exactly as the rigid body made of all its rfes.
 #include <gtest/gtest.h>

@@ -335,7 +335,11 @@ def main(argv=None):
             raise OSError("permission denied")
         if not h5py.is_hdf5(args.result):
             raise OSError("not an HDF5 file")
-        with h5py.File(args.result, "r") as f:
+        try:
+            f = h5py.File(args.result, "r")
+        except OSError:  # a run killed while it wrote (SWMR flags still set): open it as SWMR reader
+            f = h5py.File(args.result, "r", libver="latest", swmr=True)
+        with f:
             groups = [k for k in f if isinstance(f[k], h5py.Group)]
             case = os.path.splitext(os.path.basename(text_attr(f, "case_path")))[0]
             runs = {k: Run(f[k], k, case) for k in groups if "time" in f[k]}

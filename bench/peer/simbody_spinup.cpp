@@ -2,7 +2,7 @@
 // the same RFEM chain of rigid bodies and springs, integrated by Simbody's own equations of motion.
 //
 // This program must not link rfem's libraries: libSimTKmath exports old SUNDIALS N_V* symbols that
-// would silently replace SUNDIALS 6's in one process (shared/TOOLCHAIN.md, "Peers"). So the beam data
+// would silently replace SUNDIALS 6's in one process. So the beam data
 // of the case are repeated here, and the comparison with rfem's HDF5 output is done by compare.py.
 //
 // Model (rfem's discretisation, core/link.cpp): n equal parts of length Δl = L/n, one sde at the
@@ -17,7 +17,7 @@
 //   bushing  Force::LinearBushing at each sde, stiffness [GJ EIy EIz EA κGA κGA]/Δl in the frame
 //            of the inboard rfe, rotations as x-y-z body-fixed Euler angles of the relative rotation:
 //            an element written independently of rfem, equal to rfem's sde to first order.
-//   rfem     rfem's sde energy exactly (FORMULATION.md §3): Δx = p_p − p_l in hub axes and
+//   rfem     rfem's sde energy exactly (docs/formulation.md §3): Δx = p_p − p_l in hub axes and
 //            Δφ = φ_p − φ_l with φ the X-Y-Z angles of each rfe relative to the hub. Then the only
 //            remaining difference to rfem is the equations of motion and the integrator.
 
@@ -94,7 +94,7 @@ struct Sde {
   Vec3 c, k;
 };
 
-// rfem's sde energy, transcribed from FORMULATION.md §3 (not from rfem's code): with the hub frame {r},
+// rfem's sde energy, transcribed from docs/formulation.md §3 (not from rfem's code): with the hub frame {r},
 //   V = Σ_e ½ Δxᵀ diag(c) Δx + ½ Δφᵀ diag(k) Δφ,  Δx = p_p − p_l in {r} axes,  Δφ = φ_p − φ_l,
 // φ_k = X-Y-Z body-fixed angles of rfe k's rotation in {r} (0 for the hub). The translational part is
 // applied as forces at the attachment stations (exact virtual work); the angular part as generalised

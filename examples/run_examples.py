@@ -1,0 +1,90 @@
+#!/usr/bin/python3
+"""Runs the examples and compares what they print with their answer files (answers/NAME.out),
+SUNDIALS' habit: a changed number is a changed result.
+
+    /usr/bin/python3 examples/run_examples.py [--pythonpath build/python] [--cpp BUILD/ex6_library]
+                                              [--only ex1,ex3] [--update]
+
+Text must match exactly; numbers to a relative 1e-5 (or 1e-12 absolute). Why 1e-5: builds for
+different CPUs round differently (an AVX-512 build against a portable one: the shipped cases'
+results differ by at most 2.2e-7 relative, where a force-input run takes a different step
+sequence; 1e-11 where the steps are the same), and the defaults' own integration error is up to
+3e-5 of a peak (README, "Performance"). A tolerance between the two passes round-off and fails on
+any change of the physics or of the method's accuracy. Lines starting with "#" are not compared.
+"""
+import argparse
+import difflib
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?|[-+]?\b(?:nan|inf)\b")
+RTOL, ATOL = 1e-5, 1e-12
+PYTHON = ["ex1_paper_figures", "ex2_refinement", "ex3_parameter_study", "ex4_modes_rotation", "ex5_two_link_pd"]
+
+
+def same(expected, got):
+    """Whether two outputs agree: the same text between numbers, numbers within tolerance."""
+    a, b = expected.splitlines(), got.splitlines()
+    if len(a) != len(b):
+        return False
+    for x, y in zip(a, b):
+        if x.startswith("#") and y.startswith("#"):
+            continue
+        if NUMBER.sub("#", x) != NUMBER.sub("#", y):
+            return False
+        for p, q in zip(NUMBER.findall(x), NUMBER.findall(y)):
+            fp, fq = float(p), float(q)
+            if p == q or (fp != fp and fq != fq):
+                continue
+            if not abs(fp - fq) <= RTOL * max(abs(fp), abs(fq)) + ATOL:
+                return False
+    return True
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--pythonpath", help="directory holding the rfem package (default: the installed one)")
+    ap.add_argument("--cpp", help="the built ex6_library (Example 6, against the installed library)")
+    ap.add_argument("--only", help="comma-separated example names (ex1, ex6, …)")
+    ap.add_argument("--update", action="store_true", help="rewrite the answer files")
+    args = ap.parse_args()
+    env = dict(os.environ, OMP_WAIT_POLICY="PASSIVE")
+    if args.pythonpath:
+        env["PYTHONPATH"] = os.path.abspath(args.pythonpath)
+    jobs = [(name, [sys.executable, os.path.join(HERE, name + ".py")]) for name in PYTHON]
+    if args.cpp:
+        jobs.append(("ex6_library", [os.path.abspath(args.cpp), os.path.join(HERE, "..", "cases")]))
+    if args.only:
+        wanted = args.only.split(",")
+        jobs = [(n, c) for n, c in jobs if any(n == w or n.startswith(w + "_") for w in wanted)]
+    failed = 0
+    for name, cmd in jobs:
+        with tempfile.TemporaryDirectory() as scratch:
+            p = subprocess.run(cmd, cwd=scratch, capture_output=True, text=True, env=env)
+        answer = os.path.join(HERE, "answers", name + ".out")
+        if p.returncode != 0:
+            print(f"FAIL {name}: exit {p.returncode}\n{p.stderr}")
+            failed += 1
+            continue
+        if args.update:
+            with open(answer, "w") as f:
+                f.write(p.stdout)
+            print(f"wrote {answer}")
+            continue
+        expected = open(answer).read() if os.path.exists(answer) else ""
+        if same(expected, p.stdout):
+            print(f"ok   {name}")
+        else:
+            failed += 1
+            print(f"FAIL {name}: its output differs from {answer}:")
+            sys.stdout.writelines(difflib.unified_diff(expected.splitlines(True), p.stdout.splitlines(True), answer, "now"))
+    print(f"{len(jobs) - failed} examples agree with their answers, {failed} do not")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

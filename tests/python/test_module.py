@@ -1,0 +1,169 @@
+"""The Python module against the program: the same library behind both, so the same numbers (bit
+for bit with one thread), the same one-line errors, Ctrl-C that keeps what was done, and objects
+that stay valid under garbage collection. Run by CTest (label unit) with the build's module:
+
+    PYTHONPATH=build/python RFEM=build/apps/rfem /usr/bin/python3 -m pytest -q tests/python
+"""
+import gc
+import json
+import os
+import signal
+import subprocess
+
+import h5py
+import numpy as np
+import pytest
+
+import rfem
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+RFEM = os.environ.get("RFEM", os.path.join(ROOT, "build", "apps", "rfem"))
+
+
+def case_path(name):
+    return os.path.join(ROOT, "cases", name)
+
+
+def program(*args, cwd=None):
+    p = subprocess.run([RFEM, *args], capture_output=True, text=True, cwd=cwd,
+                       env=dict(os.environ, OMP_WAIT_POLICY="PASSIVE"))
+    return p.returncode, p.stdout, p.stderr
+
+
+# The shipped cases, shortened: every kind of input, one and several links, a free base.
+RUNS = [("kane_spinup.toml", 12, ["simulation.t_end=2"]),
+        ("paper_deployment.toml", 6, ["simulation.t_end=1"]),
+        ("two_link_arm.toml", 8, ["simulation.t_end=0.5"]),
+        ("space_deployment.toml", 6, ["simulation.t_end=0.5"])]
+
+
+@pytest.mark.parametrize("name,n,sets", RUNS)
+def test_run_equals_program(tmp_path, name, n, sets):
+    cli = tmp_path / "cli.h5"
+    args = ["--threads", "1", "run", case_path(name), "--n", str(n), "-q", "-o", str(cli)]
+    for s in sets:
+        args += ["--set", s]
+    code, _, err = program(*args)
+    assert code == 0, err
+    case = rfem.load(case_path(name), overrides=sets)
+    py_file = tmp_path / "py.h5"
+    runs = rfem.run(case, n=n, threads=1, output=py_file)
+    assert runs.completed
+    with h5py.File(cli, "r") as f, h5py.File(py_file, "r") as g:
+        for r in runs:
+            assert f[r.name].attrs["status"] == r.status == "completed"
+            assert f[r.name].attrs["steps"] == r.stats["steps"]
+            for series in r.names:
+                mem = r.table(series)
+                # in memory and in the module's file: the program's numbers, bit for bit
+                np.testing.assert_array_equal(mem, f[r.name][series][()], err_msg=f"{name} {r.name}/{series}")
+                np.testing.assert_array_equal(g[r.name][series][()], f[r.name][series][()])
+
+
+def test_static_modes_refine_equal_program():
+    code, out, err = program("static", case_path("two_link_arm.toml"), "--set", "loads.tip_force=[0,0.5,0]", "--json")
+    assert code == 0, err
+    js = json.loads(out)
+    st = rfem.static(rfem.load(case_path("two_link_arm.toml"), {"loads.tip_force": [0, 0.5, 0]}))
+    for link in js["links"]:
+        assert list(st.tips[link["name"]]["displacement"]) == link["tip_displacement"]
+    assert st.elastic_energy == js["elastic_energy"]
+    code, out, err = program("modes", case_path("kane_spinup.toml"), "--free", "hub", "--count", "4", "--json")
+    js = json.loads(out)
+    md = rfem.modes(rfem.load(case_path("kane_spinup.toml")), count=4, free=["hub"])
+    assert [m["frequency_hz"] for m in js["modes"]] == list(md.frequencies)
+    assert [m["kind"] for m in js["modes"]] == md.kinds
+    # the shapes are M-orthonormal: what modes of a symmetric problem must be
+    assert md.shapes.shape == (6 * 40 + 1, 4)
+    code, out, err = program("refine", case_path("kane_beam.toml"), "--n", "5,10,20", "--quantity", "bending-y:1,tip:uz",
+                             "--json")
+    js = json.loads(out)
+    ref = rfem.refine(rfem.load(case_path("kane_beam.toml")), ns=[5, 10, 20], quantities=["bending-y:1", "tip:uz"])
+    for q in js["quantities"]:
+        assert [r["value"] for r in q["rows"]] == list(ref.table(q["quantity"])["value"])
+    # the static tip converges with order 2 (docs/formulation.md §7.5)
+    assert abs(ref.table("tip:uz")["order"][-1] - 2.0) < 0.05
+
+
+@pytest.mark.parametrize("bad", ["14_negative_E.toml", "85_unknown_parent.toml", "51_unknown_input_kind.toml"])
+def test_bad_input_same_message(bad):
+    path = os.path.join(ROOT, "tests", "bad_cases", bad)
+    code, _, err = program("static", path)
+    assert code == 2 and err.startswith("rfem: error: ")
+    with pytest.raises(rfem.CaseError) as e:
+        rfem.load(path)
+    assert str(e.value) == err.strip()[len("rfem: error: "):]
+    assert isinstance(e.value, ValueError)
+
+
+def test_case_changed_in_memory(tmp_path):
+    case = rfem.load(case_path("kane_spinup.toml"))
+    faster = case.with_values({"joints.0.input.Omega": 10, "simulation.t_end": 1.0, "link.n": 8})
+    assert case.t_end == 20.0 and faster.t_end == 1.0  # the original is untouched
+    code, _, err = program("--threads", "1", "run", case_path("kane_spinup.toml"), "-q", "-o", str(tmp_path / "c.h5"),
+                           "--set", "joints.0.input.Omega=10", "--set", "simulation.t_end=1.0", "--set", "link.n=8")
+    assert code == 0, err
+    r = rfem.run(faster, threads=1)[0]
+    with h5py.File(tmp_path / "c.h5", "r") as f:
+        np.testing.assert_array_equal(r.table("joint_tau"), f["run/joint_tau"][()])
+    # the hub follows Kane's spin-up law to Omega = 10 rad/s (docs/formulation.md §3)
+    T = 15.0
+    t = r.column("time", 0)
+    law = 10.0 / T * (t ** 2 / 2 + (T / (2 * np.pi)) ** 2 * (np.cos(2 * np.pi * t / T) - 1))
+    np.testing.assert_allclose(r.column("joint_q", 0), law, rtol=0, atol=1e-12)
+    with pytest.raises(rfem.CaseError, match=r"materials\.kane\.E: must be positive"):
+        case.with_values({"materials.kane.E": -1.0})
+    with pytest.raises(rfem.CaseError, match=r"simulation\.t_ned: unknown key"):
+        case.with_values({"simulation.t_ned": 1.0})
+
+
+def test_ctrl_c_keeps_the_results_and_the_next_run_goes_on(tmp_path):
+    case = rfem.load(case_path("paper_deployment.toml"), {"simulation.procedure": "single", "simulation.t_end": 6.0})
+    sent = []
+
+    def progress(p):  # Ctrl-C from inside the run, once it is under way: deterministic
+        if p["t"] > 1.0 and not sent:
+            sent.append(p["t"])
+            os.kill(os.getpid(), signal.SIGINT)
+
+    with pytest.raises(rfem.RunInterrupted) as e:
+        rfem.run(case, n=60, threads=1, output=tmp_path / "i.h5", progress=progress)
+    assert isinstance(e.value, KeyboardInterrupt)
+    runs = e.value.result
+    r = runs[0]
+    assert r.status == "interrupted (signal 2)"
+    t = r.column("time", 0)
+    assert len(t) >= 20 and t[-1] < 6.0
+    np.testing.assert_allclose(t, 0.02 * np.arange(len(t)), atol=1e-9)  # every output up to the stop
+    with h5py.File(tmp_path / "i.h5", "r") as f:
+        assert f["run"].attrs["status"] == "interrupted (signal 2)"
+        assert f["run/time"].shape[0] == len(t)
+        np.testing.assert_array_equal(f["run/joint_tau"][()], r.table("joint_tau"))
+    # A second run in the same process is not stopped by the first's interrupt, and agrees with
+    # the interrupted one where neither's end shapes the steps (t ≤ 1 s).
+    again = rfem.run(case.with_values({"simulation.t_end": 1.5}), n=60, threads=1)[0]
+    assert again.completed
+    k = int(np.searchsorted(t, 1.0 + 1e-9))
+    np.testing.assert_array_equal(again.table("joint_tau")[:k], r.table("joint_tau")[:k])
+
+
+def test_arrays_outlive_their_run():
+    r = rfem.run(rfem.load(case_path("kane_spinup.toml"), {"simulation.t_end": 1.0, "link.n": 6}), threads=1)[0]
+    tau = r.column("joint_tau", 0)
+    tip = r.table("tip_deflection")
+    copy = np.array(tau)
+    assert not tau.flags.writeable
+    del r
+    gc.collect()
+    for _ in range(3):  # other allocations reuse freed memory if the buffer were gone
+        rfem.run(rfem.load(case_path("kane_spinup.toml"), {"simulation.t_end": 0.5, "link.n": 6}), threads=1)
+    np.testing.assert_array_equal(tau, copy)
+    assert tip.shape == (21, 3)
+
+
+def test_help_and_names():
+    assert "n:" in rfem.run.__doc__ and "output:" in rfem.run.__doc__
+    assert "Ctrl-C" in rfem.__doc__
+    assert rfem.__version__ == program("--version")[1].split()[1]
+    m = rfem.model(rfem.load(case_path("two_link_arm.toml")), n=16)
+    assert (m.n, m.m) == (16, 2) and [l["name"] for l in m.links] == ["upper", "forearm"]
