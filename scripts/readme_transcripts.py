@@ -9,8 +9,8 @@
 
 is the real output of its command (stdout; run from the repository root with the given rfem). Checks
 them (exit 1 with a diff on a mismatch) or, with --update, rewrites them. Numbers match when they
-agree to 1e-9 relative (or 1e-12 absolute): builds for different CPUs (-march=native) differ in
-the last digits of the 13 printed (a dense eigen-solution's round-off), not in anything a reader
+agree to 1e-7 relative (or 1e-12 absolute): builds for different CPUs differ in
+the last digits of the 13 printed (a dense eigen-solution of n = 80: 1e-8 between two builds), not in anything a reader
 of the README relies on; any other difference in text or digits is a mismatch.
 
     /usr/bin/python3 scripts/readme_transcripts.py [--rfem build/apps/rfem] [--update]
@@ -45,7 +45,7 @@ NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 
 
 def same(expected, got):
-    """Text equal, numbers equal to 1e-9 relative (1e-12 absolute)."""
+    """Text equal, numbers equal to 1e-7 relative (1e-12 absolute)."""
     a, b = NUMBER.split(expected), NUMBER.split(got)
     if a != b:
         return False
@@ -53,7 +53,7 @@ def same(expected, got):
         if x == y:
             continue
         u, v = float(x), float(y)
-        if abs(u - v) > max(1e-9 * max(abs(u), abs(v)), 1e-12):
+        if abs(u - v) > max(1e-7 * max(abs(u), abs(v)), 1e-12):
             return False
     return True
 

@@ -155,6 +155,43 @@ ModeKind classify(const VecX& phi, const BlockMass& bm) {
   return static_cast<ModeKind>(best);
 }
 
+// Within a cluster of equal eigenvalues (a beam with Iy = Iz bends alike in both planes) any basis
+// is an eigenbasis, and round-off picks one: rotate it to the basis that splits the modes by the
+// bending-y weight of classify(), then order them by kind, so the modes of a cluster come out the
+// same on every machine. The rotation is orthogonal: the shapes stay M-orthonormal.
+void separate_degenerate(const VecX& lambda, MatX& shapes, VecX& uncertainty, const BlockMass& bm) {
+  const int count = static_cast<int>(lambda.size());
+  static const int kind_of[6] = {0, 1, 2, 3, 2, 1};
+  for (int i = 0; i < count;) {
+    int j = i + 1;
+    while (j < count && std::abs(lambda[j] - lambda[i]) <= 1e-8 * std::max(std::abs(lambda[i]), 1e-300)) ++j;
+    const int c = j - i;
+    if (c >= 2) {
+      MatX P = MatX::Zero(c, c);  // φ_aᵀ W_y φ_b over the cluster
+      for (int a = 0; a < c; ++a)
+        for (int b = 0; b <= a; ++b) {
+          double s = 0.0;
+          for (size_t k = 0; k < bm.M.size(); ++k)
+            for (int d = 0; d < 6; ++d)
+              if (kind_of[d] == 1) s += bm.M[k](d, d) * shapes(6 * k + d, i + a) * shapes(6 * k + d, i + b);
+          P(a, b) = P(b, a) = s;
+        }
+      Eigen::SelfAdjointEigenSolver<MatX> es(P);
+      // Most bending-y first (descending weight), each vector's sign fixed by its largest entry.
+      const MatX V = es.eigenvectors().rowwise().reverse();
+      MatX block = shapes.middleCols(i, c) * V;
+      for (int a = 0; a < c; ++a) {
+        Eigen::Index at;
+        block.col(a).cwiseAbs().maxCoeff(&at);
+        if (block(at, a) < 0) block.col(a) = -block.col(a);
+      }
+      shapes.middleCols(i, c) = block;
+      uncertainty.segment(i, c).setConstant(uncertainty.segment(i, c).maxCoeff());
+    }
+    i = j;
+  }
+}
+
 }  // namespace
 
 ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, int count, int dense_limit,
@@ -258,6 +295,7 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
   double stiffest = 0.0;
   for (int k = 0; k < n; ++k)
     for (int i = 0; i < 6; ++i) stiffest = std::max(stiffest, K[pattern.slot(6 * k + i, 6 * k + i)] / bm.M[k](i, i));
+  separate_degenerate(lambda, res.shapes, res.uncertainty, bm);
   res.omega = lambda.cwiseMax(0.0).cwiseSqrt();
   for (int i = 0; i < count; ++i) {
     const bool rigid = nf > 0 && std::abs(lambda[i]) <= kRigidModeFraction * stiffest;

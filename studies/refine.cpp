@@ -98,8 +98,11 @@ RefineResult refine(const Case& cs, const RefineRequest& rq) {
       res.status = RunStatus::interrupted(rq.stop.signal());
       break;
     }
-    for (size_t k = 0; k < qs.size(); ++k)
+    for (size_t k = 0; k < qs.size(); ++k) {
       values[k].push_back(qs[k].dynamic() ? dyn[k] : evaluate_quantity(cs, n, qs[k], rq.rate));
+      if (!std::isfinite(values[k].back()))
+        throw std::runtime_error("n = " + std::to_string(n) + ": " + qs[k].text + " is not finite: check the case's values");
+    }
     res.ns.push_back(n);
   }
   // The integration error of the finest run: the same n at tolerances 100 times tighter.

@@ -31,7 +31,7 @@ if [[ $# -gt 0 ]]; then
   for name in "$@"; do cases+=("$here/${name%.toml}.toml"); done
 else
   shopt -s nullglob
-  cases=("$here"/[0-9][0-9]_*.toml)
+  cases=("$here"/[0-9][0-9]_*.toml "$here"/[0-9][0-9][0-9]_*.toml)
 fi
 if [[ ${#cases[@]} -eq 0 ]]; then
   echo "run_corpus.sh: no case files in $here" >&2
