@@ -376,21 +376,13 @@ PYBIND11_MODULE(_rfem, m) {
     for (size_t k = 0; k < res.tables.size(); ++k) {
       const Refinement& t = res.tables[k];
       std::vector<int> n;
-      std::vector<double> value, change, order, rich;
-      for (const auto& r : t.rows) {
-        n.push_back(r.n);
-        value.push_back(r.value);
-        change.push_back(r.change);
-        order.push_back(r.order);
-        rich.push_back(r.richardson);
-      }
+      for (const auto& r : t.rows) n.push_back(r.n);
       py::dict d;
       d["quantity"] = res.quantities[k].text;
       d["n"] = py::array(py::cast(n));
-      d["value"] = py::array(py::cast(value));
-      d["change"] = py::array(py::cast(change));
-      d["order"] = py::array(py::cast(order));
-      d["richardson"] = py::array(py::cast(rich));
+      for (auto [name, field] : {std::pair{"value", &RefinementRow::value}, {"change", &RefinementRow::change},
+                                 {"order", &RefinementRow::order}, {"richardson", &RefinementRow::richardson}})
+        d[name] = py::array(py::cast(t.column(field)));
       d["fitted_order"] = t.fitted_order;
       d["integration_error"] = t.integration_error;
       d["reference"] = t.reference();

@@ -207,20 +207,13 @@ void ResultsWriter::write_refinement(const std::vector<std::string>& quantities,
   h5::write_attribute(g, "quantities", static_cast<long>(quantities.size()));
   for (size_t k = 0; k < quantities.size(); ++k) {
     const Refinement& t = tables[k];
-    std::vector<double> val, change, order, rich;
-    for (const auto& r : t.rows) {
-      val.push_back(r.value);
-      change.push_back(r.change);
-      order.push_back(r.order);
-      rich.push_back(r.richardson);
-    }
     const h5::Handle q = h5::group(H5Gcreate2(g, ("q" + std::to_string(k)).c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), what);
     for (hid_t where : {q.get(), k == 0 ? g.get() : hid_t(-1)}) {
       if (where < 0) continue;
-      put_vector(where, "value", val, what);
-      put_vector(where, "change", change, what);
-      put_vector(where, "order", order, what);
-      put_vector(where, "richardson", rich, what);
+      put_vector(where, "value", t.column(&RefinementRow::value), what);
+      put_vector(where, "change", t.column(&RefinementRow::change), what);
+      put_vector(where, "order", t.column(&RefinementRow::order), what);
+      put_vector(where, "richardson", t.column(&RefinementRow::richardson), what);
       h5::write_attribute(where, "quantity", quantities[k]);
       h5::write_attribute(where, "fitted_order", t.fitted_order);
       h5::write_attribute(where, "integration_error", t.integration_error);

@@ -26,6 +26,12 @@ struct Refinement {
   std::vector<std::string> warnings;
   /// The extrapolated value of the last row (NaN when the series cannot be trusted).
   double reference() const { return rows.empty() ? 0.0 : rows.back().richardson; }
+  /// One field of every row, as a column (e.g. column(&RefinementRow::value)).
+  std::vector<double> column(double RefinementRow::*field) const {
+    std::vector<double> out;
+    for (const auto& r : rows) out.push_back(r.*field);
+    return out;
+  }
 };
 
 /// `ns` strictly increasing, one value each; `integration_error` NaN if unknown.

@@ -138,15 +138,20 @@ wait $pid
 s=$(status shared.h5 force)
 [[ $s == "completed | 20.0 | 1001" ]] && ok "the first run's file is whole: force $s" || bad "first run: $s ($(cat first.err))"
 
-# 7. SIGHUP (a closed terminal) stops a run like SIGTERM, its file closed (once: left flagged open).
-"$rfem" run "$src/cases/paper_deployment.toml" --n 1500 --set simulation.procedure=\"single\" -q -o hup.h5 2>/dev/null &
-pid=$!
-for _ in $(seq 600); do
-  /usr/bin/python3 -c "
+# A long run writing $1, once it has written two outputs (read live, SWMR); its pid in $pid.
+start_long_run() {
+  "$rfem" run "$src/cases/paper_deployment.toml" --n 1500 --set simulation.procedure=\"single\" -q -o "$1" 2>/dev/null &
+  pid=$!
+  for _ in $(seq 600); do
+    /usr/bin/python3 -c "
 import h5py, sys
-d = h5py.File('hup.h5', 'r', libver='latest', swmr=True)['run/time']; d.refresh(); sys.exit(0 if d.shape[0] >= 2 else 1)" 2>/dev/null && break
-  sleep 0.1
-done
+d = h5py.File('$1', 'r', libver='latest', swmr=True)['run/time']; d.refresh(); sys.exit(0 if d.shape[0] >= 2 else 1)" 2>/dev/null && break
+    sleep 0.1
+  done
+}
+
+# 7. SIGHUP (a closed terminal) stops a run like SIGTERM, its file closed (once: left flagged open).
+start_long_run hup.h5
 kill -HUP $pid; wait $pid; code=$?
 [ $code = 129 ] && ok "SIGHUP: exit 129" || bad "SIGHUP: exit $code"
 /usr/bin/python3 -c "import h5py; print(h5py.File('hup.h5', 'r')['run'].attrs['status'])" 2>&1 | grep -q "interrupted (signal 1)" \
@@ -154,14 +159,7 @@ kill -HUP $pid; wait $pid; code=$?
 
 # 8. SIGKILL leaves the file flagged open for SWMR: it opens with swmr=True (README), and rfem plot
 #    reads it.
-"$rfem" run "$src/cases/paper_deployment.toml" --n 1500 --set simulation.procedure=\"single\" -q -o killed.h5 2>/dev/null &
-pid=$!
-for _ in $(seq 600); do
-  /usr/bin/python3 -c "
-import h5py, sys
-d = h5py.File('killed.h5', 'r', libver='latest', swmr=True)['run/time']; d.refresh(); sys.exit(0 if d.shape[0] >= 2 else 1)" 2>/dev/null && break
-  sleep 0.1
-done
+start_long_run killed.h5
 kill -KILL $pid; wait $pid 2>/dev/null
 s=$(status killed.h5 run)
 [[ $s == "running | none | "* ]] && ok "a killed run's file reads with swmr=True: $s" || bad "killed.h5: $s"
