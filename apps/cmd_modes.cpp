@@ -4,6 +4,7 @@
 
 #include "commands.hpp"
 #include "rfem/studies/modes_study.hpp"
+#include "rfem/studies/recorders.hpp"
 
 namespace rfem::app {
 
@@ -54,6 +55,12 @@ int run_modes(const Common& c, const ModesOptions& o) {
                  fmt::format("{}{}", to_string(r.kind[i]), s.index_of_kind[i]), extra);
   }
   for (const auto& w : s.warnings) print_warning(w);
+  if (!o.output.empty()) {
+    ResultsWriter file = create_results(o.output, describe(cs, c.command_line, "modes", model.n(), max_threads(c)));
+    write_modes(file, s);
+    file.close();
+    if (!c.json) fmt::print("mode shapes in {}\n", o.output);
+  }
   if (!c.json && s.has_reference)
     fmt::print("reference: (T) Timoshenko cantilever (shear and rotary inertia), (rod) rod theory; the error is "
                "the discretisation's and falls as 1/n²\n");

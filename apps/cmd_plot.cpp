@@ -20,13 +20,15 @@ std::string plot_script() {
 }
 }  // namespace
 
-int run_plot(const std::string& results, const std::string& outdir) {
+int run_plot(const std::string& results, const std::string& outdir, const std::string& format, bool paper_signs) {
   const std::string script = plot_script();
   if (!std::filesystem::exists(script))
     throw std::runtime_error("plot script not found: " + script + " (set RFEM_PLOT_SCRIPT to tools/rfem_plot.py)");
   const char* python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   std::vector<std::string> args{python, script, results};
   if (!outdir.empty()) args.insert(args.end(), {"-o", outdir});
+  if (!format.empty()) args.insert(args.end(), {"--format", format});
+  if (paper_signs) args.push_back("--paper-signs");
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);

@@ -88,7 +88,7 @@ int run_simulation(const Common& c, const std::string& output) {
                     {"residual_evals", r.stats.residual_evals}, {"factorizations", r.stats.factorizations},
                     {"newton_iters", r.stats.newton_iters}, {"newton_fails", r.stats.newton_fails},
                     {"error_test_fails", r.stats.error_test_fails}, {"links", links}, {"energy_drift", r.energy_drift},
-                    {"energy_scale", r.energy_scale}});
+                    {"energy_scale", r.energy_scale}, {"warnings", r.warnings}});
       if (!r.peaks.empty())  // the last link's, as with one link
         js.back().update({{"peak_u1", r.peaks.back().u1}, {"peak_u2", r.peaks.back().u2}, {"peak_theta", r.peaks.back().theta}});
     }

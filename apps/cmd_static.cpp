@@ -10,6 +10,7 @@ int run_static(const Common& c, const ModesOptions& o) {
   const Case cs = read_checked_case(c);
   const StaticStudy s = static_study(cs, c.n, o.rate);
   const StaticResult& r = s.solution;
+  for (const auto& w : s.warnings) print_warning(w);
   const Energies& E = s.energies;
   if (c.json) {
     nlohmann::json links = nlohmann::json::array();

@@ -32,6 +32,7 @@ struct ModesOptions {
   /// `rfem modes --free`: joints that move with the modes (numbers from 1, names, or "base" for a
   /// free base's six); empty: every joint held.
   std::vector<std::string> free;
+  std::string output;  ///< `rfem modes -o FILE`: the frequencies and shapes into HDF5
 };
 
 struct RefineOptions {
@@ -41,13 +42,15 @@ struct RefineOptions {
   bool integration_check = true;        ///< rerun the finest n at 100× tighter tolerances
 };
 
+/// `rfem show`: the assembled tree of joints, links and bodies.
+int run_show(const Common& c);
 int run_static(const Common& c, const ModesOptions& o);
 int run_modes(const Common& c, const ModesOptions& o);
 /// `rfem run`: time integration of the case's [simulation], results to an HDF5 file.
 int run_simulation(const Common& c, const std::string& output);
 int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o);
 /// `rfem plot RESULTS.h5 [-o DIR]`: PNG figures of a results or refinement file.
-int run_plot(const std::string& results, const std::string& outdir);
+int run_plot(const std::string& results, const std::string& outdir, const std::string& format = "", bool paper_signs = false);
 
 void print_json(const nlohmann::json& j);
 /// Prints "rfem: warning: …" on stderr.

@@ -64,12 +64,15 @@ int main(int argc, char** argv) {
     sub->add_option("--joint", mo.rate.joint, "joint (1-based) that --rate applies to")->check(kPositiveInt);
   };
 
+  auto* sh = app.add_subcommand("show", "the assembled tree: joints, links, payloads, what each sits on, masses, coordinates, inputs");
+  add_common(sh, true);
   auto* st = app.add_subcommand("static", "static equilibrium under gravity and tip loads, joints held (or turning steadily: --rate)");
   add_common(st, true);
   add_rate(st);
   auto* md = app.add_subcommand("modes", "natural frequencies and mode shapes of the flexible link, base held or joints free");
   add_common(md, true);
   md->add_option("--count", mo.count, "number of modes (at most 6n + free joints)")->check(kPositiveInt);
+  md->add_option("-o,--output", mo.output, "HDF5 file for the frequencies and mode shapes (group modes)");
   md->add_option("--free", mo.free, "joints that move with the modes: numbers from 1, names, or 'base' (a free base's six)")
       ->delimiter(',');
   add_rate(md);
@@ -80,7 +83,11 @@ int main(int argc, char** argv) {
   auto* pl = app.add_subcommand("plot", "PNG figures of a results file (the paper's Figures 5-8, runs, refinement)");
   std::string plot_file, plot_dir;
   pl->add_option("results", plot_file, "results file (HDF5) from rfem run or rfem refine")->required();
-  pl->add_option("-o,--output", plot_dir, "directory for the PNG files (default: beside the results file)");
+  pl->add_option("-o,--output", plot_dir, "directory for the figures (default: beside the results file)");
+  std::string plot_format;
+  bool paper_signs = false;
+  pl->add_option("--format", plot_format, "png (default), pdf or svg")->check(CLI::IsMember({"png", "pdf", "svg"}));
+  pl->add_flag("--paper-signs", paper_signs, "u1, u2 with the paper's (Kane's) sign, the opposite of the physical displacement");
   auto* rf = app.add_subcommand("refine", "convergence tables of quantities over a series of n");
   add_common(rf, false);
   RefineOptions ro;
@@ -103,7 +110,7 @@ int main(int argc, char** argv) {
     bool known = false;
     for (const auto* sub : app.get_subcommands([](const CLI::App*) { return true; })) known |= sub->get_name() == w;
     if (!known) {
-      fmt::print(stderr, "rfem: error: unknown command '{}' (static, modes, run, refine, plot; rfem --help)\n", w);
+      fmt::print(stderr, "rfem: error: unknown command '{}' (show, static, modes, run, refine, plot; rfem --help)\n", w);
       return 2;
     }
   }
@@ -128,9 +135,10 @@ int main(int argc, char** argv) {
   spdlog::set_pattern("[%H:%M:%S.%e] %v");
   spdlog::set_level(common.verbose ? spdlog::level::debug : spdlog::level::warn);
   try {
+    if (sh->parsed()) return run_show(common);
     if (st->parsed()) return run_static(common, mo);
     if (md->parsed()) return run_modes(common, mo);
-    if (pl->parsed()) return run_plot(plot_file, plot_dir);
+    if (pl->parsed()) return run_plot(plot_file, plot_dir, plot_format, paper_signs);
     if (rn->parsed()) {
       if (output.empty()) {
         std::string stem = common.case_path.substr(common.case_path.find_last_of('/') + 1);

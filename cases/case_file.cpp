@@ -1,5 +1,6 @@
 #include "rfem/cases/case_file.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -11,12 +12,54 @@ using namespace reading;
 
 namespace {
 
-// "a.b.0.c=value": parse the value as TOML and put it at the path (creating tables as needed).
+// Puts `value` at keys[i…] below `cur`: tables are created as needed, "*" stands for every element
+// of an array (joints.*.input.T=5).
+void set_at(toml::node& cur, const std::vector<std::string>& keys, size_t i, const toml::node& value,
+            const std::string& where) {
+  const std::string& k = keys[i];
+  const bool last = i + 1 == keys.size();
+  if (auto t = cur.as_table()) {
+    if (k == "*") throw CaseError(where + ": '*' stands for every element of an array, and '" + keys[i - 1] + "' is a table");
+    if (last) {
+      t->insert_or_assign(k, value);
+      return;
+    }
+    if (!t->get(k)) t->insert(k, toml::table{});
+    set_at(*t->get(k), keys, i + 1, value, where);
+  } else if (auto a = cur.as_array()) {
+    std::vector<size_t> which;
+    if (k == "*") {
+      if (a->empty()) throw CaseError(where + ": '" + keys[i - 1] + "' has no elements");
+      for (size_t j = 0; j < a->size(); ++j) which.push_back(j);
+    } else {
+      size_t idx = 0, used = 0;
+      try {
+        idx = std::stoul(k, &used);
+      } catch (...) {
+        used = 0;
+      }
+      if (used == 0 || used != k.size())
+        throw CaseError(where + ": '" + k + "' must be an array index (0, 1, …) or '*' ('" + keys[i - 1] + "' is an array)");
+      if (idx >= a->size())
+        throw CaseError(where + ": index " + k + " out of range ('" + keys[i - 1] + "' has " + std::to_string(a->size()) + ")");
+      which.push_back(idx);
+    }
+    for (size_t j : which) {
+      if (last) a->replace(a->begin() + static_cast<long>(j), value);
+      else set_at(*a->get(j), keys, i + 1, value, where);
+    }
+  } else {
+    throw CaseError(where + ": '" + keys[i - 1] + "' is not a table or array");
+  }
+}
+
+// "a.b.0.c=value": parse the value as TOML and put it at the path. Errors name the option.
 void apply_override(toml::table& root, const std::string& file, const std::string& spec) {
   const auto eq = spec.find('=');
   if (eq == std::string::npos || eq == 0)
     throw CaseError(file + ": --set " + spec + ": expected key.path=value");
   const std::string path = spec.substr(0, eq), value = spec.substr(eq + 1);
+  const std::string where = file + ": --set " + path;
   toml::table parsed;
   try {
     parsed = toml::parse("v = " + value);
@@ -25,40 +68,22 @@ void apply_override(toml::table& root, const std::string& file, const std::strin
     try {
       parsed = toml::parse("v = \"" + value + "\"");
     } catch (const toml::parse_error&) {
-      throw CaseError(file + ": --set " + path + ": cannot parse value '" + value + "'");
+      throw CaseError(where + ": cannot parse value '" + value + "'");
     }
   }
   std::vector<std::string> keys;
   std::stringstream ss(path);
   for (std::string k; std::getline(ss, k, '.');) keys.push_back(k);
-  toml::node* cur = &root;
-  for (size_t i = 0; i < keys.size(); ++i) {
-    const bool last = i + 1 == keys.size();
-    const std::string& k = keys[i];
-    if (auto t = cur->as_table()) {
-      if (last) {
-        t->insert_or_assign(k, *parsed.get("v"));
-        return;
-      }
-      if (!t->get(k)) t->insert(k, toml::table{});
-      cur = t->get(k);
-    } else if (auto a = cur->as_array()) {
-      size_t idx = 0;
-      try {
-        idx = std::stoul(k);
-      } catch (...) {
-        throw CaseError(file + ": --set " + path + ": '" + k + "' must be an array index");
-      }
-      if (idx >= a->size()) throw CaseError(file + ": --set " + path + ": index " + k + " out of range");
-      if (last) {
-        a->replace(a->begin() + static_cast<long>(idx), *parsed.get("v"));
-        return;
-      }
-      cur = a->get(idx);
-    } else {
-      throw CaseError(file + ": --set " + path + ": '" + keys[i - 1] + "' is not a table or array");
-    }
-  }
+  if (keys.empty() || std::any_of(keys.begin(), keys.end(), [](const std::string& k) { return k.empty(); }))
+    throw CaseError(where + ": expected key.path=value");
+  // [link] and [[links]]: say which keys this case has rather than creating the other.
+  if (keys[0] == "link" && root.get("links") && !root.get("link"))
+    throw CaseError(where + ": this case has several links ([[links]]): use links.0." +
+                    (keys.size() > 1 ? keys[1] : std::string("…")) + ", links.*." + (keys.size() > 1 ? keys[1] : std::string("…")) +
+                    (keys.size() > 1 && keys[1] == "n" ? ", or --n N for the rfes of all links" : ""));
+  if (keys[0] == "links" && root.get("link") && !root.get("links"))
+    throw CaseError(where + ": this case has one link ([link]): use link." + (keys.size() > 2 ? keys[2] : std::string("…")));
+  set_at(root, keys, 0, *parsed.get("v"), where);
 }
 
 
@@ -151,15 +176,24 @@ Case parse_case(const std::string& text, const std::string& path, const std::vec
     os << root;
     c.effective_text = os.str();
   }
-  const Reader r(path);
+  Reader r(path);
   r.check_keys(root, "", {"case", "materials", "sections", "link", "links", "joints", "gravity", "loads", "simulation", "base"});
   const std::string& case_dir = c.base_dir;
 
   if (const toml::node* n = root.get("case")) {
     if (!n->is_table()) r.fail(n, "case", "must be a table");
-    r.check_keys(*n->as_table(), "case", {"name", "description"});
-    c.name = r.string(*n->as_table(), "case", "name", std::string());
-    c.description = r.string(*n->as_table(), "case", "description", std::string());
+    const toml::table& ct = *n->as_table();
+    r.check_keys(ct, "case", {"name", "description", "accept"});
+    c.name = r.string(ct, "case", "name", std::string());
+    c.description = r.string(ct, "case", "description", std::string());
+    if (const toml::node* an = ct.get("accept")) {  // warnings the case knows of and keeps
+      const toml::array* a = an->as_array();
+      if (!a) r.fail(an, "case.accept", "must be an array of keys whose warnings the case acknowledges, e.g. [\"sections.B2.J\"]");
+      for (const toml::node& k : *a) {
+        if (!k.is_string()) r.fail(&k, "case.accept", "must be an array of keys (strings)");
+        r.accept(k.as_string()->get());
+      }
+    }
   }
   const Materials mats = read_materials(r, root);
   const Sections secs = read_sections(r, root);
@@ -199,6 +233,8 @@ Case parse_case(const std::string& text, const std::string& path, const std::vec
       if (c.loads.link < 0) r.fail(lt.get("link"), "loads.link", "no link named '" + name + "'");
     }
   }
+  for (const std::string& k : r.unused_accepts())
+    r.warn(root.get("case"), "case.accept", "'" + k + "' draws no warning here: nothing to acknowledge");
   c.warnings = r.warnings();
   return c;
 }

@@ -30,8 +30,13 @@ class Reader {
     throw CaseError(os.str());
   }
 
-  /// A legal but suspicious value: a one-line warning naming file, line and key.
+  /// A legal but suspicious value: a one-line warning naming file, line and key (unless the case
+  /// acknowledges that key's warning: [case] accept).
   void warn(const toml::node* node, const std::string& key, const std::string& what) const {
+    if (accepted_.count(key)) {
+      used_.insert(key);
+      return;
+    }
     std::ostringstream os;
     os << file_;
     if (node && node->source().begin.line > 0) os << ":" << node->source().begin.line;
@@ -39,6 +44,15 @@ class Reader {
     warnings_.push_back(os.str());
   }
   const std::vector<std::string>& warnings() const { return warnings_; }
+  /// Keys whose warnings the case acknowledges ([case] accept = ["sections.B2.J"]).
+  void accept(const std::string& key) { accepted_.insert(key); }
+  /// Acknowledged keys that drew no warning.
+  std::vector<std::string> unused_accepts() const {
+    std::vector<std::string> out;
+    for (const auto& k : accepted_)
+      if (!used_.count(k)) out.push_back(k);
+    return out;
+  }
 
   /// An angle [rad]: a number (radians), or a string "90 deg" / "1.5 rad". A plain number beyond
   /// ±2π is taken as radians but warned about (TOML has no π; degrees are a common slip).
@@ -99,6 +113,17 @@ class Reader {
     return v;
   }
 
+  /// A positive value within [lo, hi]: the range in which rfem's derived quantities (masses,
+  /// stiffnesses, frequencies) neither overflow nor vanish, far beyond any real structure.
+  double ranged(const toml::table& t, const std::string& path, const std::string& key, double lo, double hi,
+                const std::string& unit, std::optional<double> dflt = std::nullopt) const {
+    const double v = positive(t, path, key, dflt);
+    if (v < lo || v > hi)
+      fail(t.get(key) ? t.get(key) : &t, join(path, key),
+           "must lie within what rfem computes with, " + fmt(lo) + " to " + fmt(hi) + " " + unit + " (got " + fmt(v) + ")");
+    return v;
+  }
+
   double non_negative(const toml::table& t, const std::string& path, const std::string& key, double dflt) const {
     const double v = number(t, path, key, dflt);
     if (v < 0.0) fail(t.get(key), join(path, key), "must not be negative (got " + fmt(v) + ")");
@@ -146,6 +171,8 @@ class Reader {
 
   static std::string join(const std::string& a, const std::string& b) { return a.empty() ? b : a + "." + b; }
   mutable std::vector<std::string> warnings_;
+  std::set<std::string> accepted_;
+  mutable std::set<std::string> used_;
   static std::string fmt(double v) {
     std::ostringstream os;
     os << v;

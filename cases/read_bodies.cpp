@@ -24,13 +24,18 @@ Material read_material(const Reader& r, const toml::table& t, const std::string&
   r.check_keys(t, path, {"E", "G", "rho"});
   Material m;
   m.name = name;
-  m.E = r.positive(t, path, "E");
-  m.G = r.positive(t, path, "G");
-  m.rho = r.positive(t, path, "rho");
+  m.E = r.ranged(t, path, "E", 1.0, 1e20, "Pa");
+  m.G = r.ranged(t, path, "G", 1.0, 1e20, "Pa");
+  m.rho = r.ranged(t, path, "rho", 1e-3, 1e6, "kg/m^3");
   if (m.G > m.E / 2)
     r.warn(t.get("G"), path + ".G", "G > E/2 means a negative Poisson's ratio (nu = E/2G - 1 = " + Reader::fmt(m.E / (2 * m.G) - 1) + ")");
   if (m.E < 1e5) r.warn(t.get("E"), path + ".E", "E = " + Reader::fmt(m.E) + " Pa is very small: units are SI (Pa), not GPa or MPa");
   if (m.rho < 10) r.warn(t.get("rho"), path + ".rho", "rho = " + Reader::fmt(m.rho) + " kg/m^3 is very small: units are SI (kg/m^3), not g/cm^3");
+  // The stiffest and densest engineering materials: diamond (E 1.2e12 Pa), osmium (2.26e4 kg/m^3).
+  if (m.E > 1.2e12) r.warn(t.get("E"), path + ".E", "E = " + Reader::fmt(m.E) + " Pa is stiffer than diamond (1.2e12 Pa): units are Pa");
+  if (m.G > 6e11) r.warn(t.get("G"), path + ".G", "G = " + Reader::fmt(m.G) + " Pa is stiffer than diamond (5e11 Pa): units are Pa");
+  if (m.rho > 2.3e4)
+    r.warn(t.get("rho"), path + ".rho", "rho = " + Reader::fmt(m.rho) + " kg/m^3 is denser than any material (osmium: 2.26e4): units are kg/m^3");
   return m;
 }
 
@@ -40,7 +45,7 @@ Section read_section(const Reader& r, const toml::table& t, const std::string& p
     const toml::table& b = r.table(t, path, "box");
     const std::string bp = path + ".box";
     r.check_keys(b, bp, {"outer", "inner"});
-    const double outer = r.positive(b, bp, "outer"), inner = r.non_negative(b, bp, "inner", 0.0);
+    const double outer = r.ranged(b, bp, "outer", 1e-6, 1e3, "m"), inner = r.non_negative(b, bp, "inner", 0.0);
     if (inner >= outer) r.fail(b.get("inner"), bp + ".inner", "must be smaller than outer");
     Section s = box_section(name, outer, inner);
     s.kappa_y = r.positive(t, path, "kappa_y", s.kappa_y);
@@ -50,10 +55,13 @@ Section read_section(const Reader& r, const toml::table& t, const std::string& p
   r.check_keys(t, path, {"A", "Iy", "Iz", "J", "kappa_y", "kappa_z", "offset_y", "offset_z"});
   Section s;
   s.name = name;
-  s.A = r.positive(t, path, "A");
-  s.Iy = r.positive(t, path, "Iy");
-  s.Iz = r.positive(t, path, "Iz");
-  s.J = r.positive(t, path, "J");
+  s.A = r.ranged(t, path, "A", 1e-14, 1e4, "m^2");
+  s.Iy = r.ranged(t, path, "Iy", 1e-30, 1e8, "m^4");
+  s.Iz = r.ranged(t, path, "Iz", 1e-30, 1e8, "m^4");
+  s.J = r.ranged(t, path, "J", 1e-30, 1e8, "m^4");
+  if (s.A >= 1.0)
+    r.warn(t.get("A"), path + ".A", "A = " + Reader::fmt(s.A) + " m^2 is a cross-section over a metre across: if mm^2 were meant, write " +
+                                        Reader::fmt(s.A * 1e-6));
   s.kappa_y = r.positive(t, path, "kappa_y", 5.0 / 6.0);
   s.kappa_z = r.positive(t, path, "kappa_z", 5.0 / 6.0);
   s.offset = Vec3(0.0, r.number(t, path, "offset_y", 0.0), r.number(t, path, "offset_z", 0.0));
@@ -65,6 +73,11 @@ Section read_section(const Reader& r, const toml::table& t, const std::string& p
       r.warn(t.get(k), path + "." + k, "a second moment of 10 A^2 or more (" + Reader::fmt(I) + " m^4 against A^2 = " +
                                            Reader::fmt(s.A * s.A) + " m^4) needs an extremely thin wall: check the units (m^4, m^2)");
   }
+  // The disc has the smallest polar moment of all regions of area A: Iy + Iz >= A^2/(2 pi).
+  if (s.Iy + s.Iz < 0.9999 * s.A * s.A / (2 * M_PI))
+    r.warn(t.get("A"), path + ".A", "A = " + Reader::fmt(s.A) + " m^2 with Iy + Iz = " + Reader::fmt(s.Iy + s.Iz) +
+                                        " m^4 is no real section (a disc of that area has " + Reader::fmt(s.A * s.A / (2 * M_PI)) +
+                                        "): check the units (m^2, m^4)");
   if (s.J > 1.0001 * (s.Iy + s.Iz))
     r.warn(t.get("J"), path + ".J", "a torsion constant larger than Iy + Iz is impossible for a real section");
   return s;
@@ -105,7 +118,7 @@ Mat4 read_body(const Reader& r, const toml::table& t, const std::string& path, c
     const std::string sn = r.string(t, path, "section"), mn = r.string(t, path, "material");
     if (!secs.count(sn)) r.fail(t.get("section"), path + ".section", "no section named '" + sn + "'");
     if (!mats.count(mn)) r.fail(t.get("material"), path + ".material", "no material named '" + mn + "'");
-    const double L = r.positive(t, path, "length");
+    const double L = r.ranged(t, path, "length", 1e-6, 1e6, "m");
     const Section& s = secs.at(sn);
     const double rho = mats.at(mn).rho, mass = rho * s.A * L;
     Mat3 I = Mat3::Zero();  // about the mass centre; Ixx from the polar second moment
@@ -120,6 +133,7 @@ Mat4 read_body(const Reader& r, const toml::table& t, const std::string& path, c
   keys.insert(extra.begin(), extra.end());
   r.check_keys(t, path, keys);
   const double mass = r.non_negative(t, path, "mass", 0.0);
+  if (mass > 1e12) r.fail(t.get("mass"), path + ".mass", "must lie within what rfem computes with, 0 to 1e12 kg (got " + Reader::fmt(mass) + ")");
   const Vec3 com = r.vec3(t, path, "com", Vec3::Zero());
   Mat3 I = Mat3::Zero();
   if (const toml::node* n = t.get("inertia")) {

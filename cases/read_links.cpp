@@ -32,7 +32,7 @@ LinkCase read_link(const Reader& r, const toml::table& lt, const std::string& ke
     const std::string p = key + ".segments." + std::to_string(i);
     r.check_keys(st, p, {"length", "material", "section", "parts"});
     Segment s;
-    s.length = r.positive(st, p, "length");
+    s.length = r.ranged(st, p, "length", 1e-6, 1e6, "m");
     const std::string mn = r.string(st, p, "material"), sc = r.string(st, p, "section");
     if (!mats.count(mn)) r.fail(st.get("material"), p + ".material", "no material named '" + mn + "'");
     if (!secs.count(sc)) r.fail(st.get("section"), p + ".section", "no section named '" + sc + "'");
@@ -57,6 +57,13 @@ LinkCase read_link(const Reader& r, const toml::table& lt, const std::string& ke
       pl.at = std::min(pl.at, L);
       pl.H = read_body(r, pt, p, mats, secs, {"at"});
       if (pl.H(3, 3) <= 0.0) r.fail(&pt, p + ".mass", "a payload needs a positive mass");
+      double link_mass = 0.0;
+      for (const Segment& s : c.link.segments) link_mass += s.material.rho * s.section.A * s.length;
+      if (pl.H(3, 3) > 100 * link_mass)
+        r.warn(pt.get("mass") ? pt.get("mass") : &pt, p + ".mass",
+               "a payload of " + Reader::fmt(pl.H(3, 3)) + " kg is " + Reader::fmt(std::round(pl.H(3, 3) / link_mass)) +
+                   " times the link's mass (" + Reader::fmt(link_mass) + " kg): units are kg (if grams were meant, write " +
+                   Reader::fmt(pl.H(3, 3) * 1e-3) + ")");
       c.link.payloads.push_back(pl);
     }
   }
@@ -162,6 +169,21 @@ void resolve_parents(const Reader& r, Case& c, const std::vector<ParentRef>& joi
   }
   for (int j = 0; j < m; ++j) c.joints[j].on = jon[j];
   for (int l = 0; l < nl; ++l) c.links[l].on = lon[l];
+  // A joint left without a parent sits on the previous joint; where a link sits there too, the
+  // joint was often meant to sit on that link (an elbow on the upper arm's tip): say so.
+  for (int j = 1; j < m; ++j) {
+    const ParentRef& pr = joint_parents[j];
+    if (!pr.name.empty() || pr.path == "base" || c.joints[j].on.kind != Mounting::Kind::Joint) continue;
+    for (int l = 0; l < nl; ++l)
+      if (c.links[l].on.kind == Mounting::Kind::Joint && c.links[l].on.index == j - 1) {
+        const std::string& prev = c.joints[j - 1].name;
+        r.warn(pr.node, pr.path + ".parent",
+               "missing: joint '" + c.joints[j].name + "' sits on the previous joint '" + prev + "', where link '" +
+                   c.links[l].name + "' sits too; to mount it on that link write parent = \"" + c.links[l].name +
+                   "\" (at its tip), or parent = \"" + prev + "\" to keep it where it is");
+        break;
+      }
+  }
 }
 
 }  // namespace rfem::reading

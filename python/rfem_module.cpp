@@ -20,6 +20,7 @@
 #include "rfem/studies/recorders.hpp"
 #include "rfem/studies/refine.hpp"
 #include "rfem/studies/runs.hpp"
+#include "rfem/studies/show.hpp"
 #include "rfem/studies/static_study.hpp"
 #include "rfem/version.hpp"
 
@@ -200,6 +201,7 @@ PYBIND11_MODULE(_rfem, m) {
         return d;
       }, "per link: peak |u1|, |u2| [m], |theta| [rad]")
       .def_readonly("energy_drift", &RunResult::energy_drift, "max |balance(t) - balance(0)| [J]")
+      .def_readonly("warnings", &RunResult::warnings, "where the solution left the small deformation the model assumes")
       .def_readonly("energy_scale", &RunResult::energy_scale, "[J]")
       .def_property_readonly("model", [](const RunResult& r) { return std::const_pointer_cast<Model>(r.model); })
       .def_property_readonly("names", [](const RunResult& r) {
@@ -275,6 +277,17 @@ PYBIND11_MODULE(_rfem, m) {
   }, py::arg("case"), py::arg("n"), py::arg("output"), py::arg("runs"), py::arg("threads"), py::arg("keep_series"),
      py::arg("progress"));
 
+  m.def("_show", [](const Case& cs, int n) {
+    const ModelSummary s = show_model(cs, n);
+    py::list entries;
+    for (const TreeEntry& e : s.entries)
+      entries.append(py::dict(py::arg("kind") = e.kind, py::arg("name") = e.name, py::arg("depth") = e.depth,
+                              py::arg("parent") = e.parent, py::arg("where") = e.where, py::arg("mass") = e.mass,
+                              py::arg("length") = e.length, py::arg("rfes") = e.rfes, py::arg("detail") = e.detail,
+                              py::arg("coordinates") = e.coordinates));
+    return py::make_tuple(format_summary(s), entries);
+  }, py::arg("case"), py::arg("n"));
+
   py::class_<StaticStudy, std::shared_ptr<StaticStudy>>(m, "StaticResult", "A static equilibrium (rfem.static).")
       .def_property_readonly("n", [](const StaticStudy& s) { return s.model->n(); })
       .def_property_readonly("iterations", [](const StaticStudy& s) { return s.solution.iterations; })
@@ -283,6 +296,7 @@ PYBIND11_MODULE(_rfem, m) {
       .def_property_readonly("q", [](const StaticStudy& s) { return vector_array(s.solution.q); }, "all coordinates")
       .def_property_readonly("elastic_energy", [](const StaticStudy& s) { return s.energies.elastic; }, "[J]")
       .def_property_readonly("gravity_energy", [](const StaticStudy& s) { return s.energies.gravity; }, "[J]")
+      .def_readonly("warnings", &StaticStudy::warnings)
       .def_property_readonly("tips", [](const StaticStudy& s) {
         py::dict d;
         for (const LinkTip& t : s.tips)
@@ -324,15 +338,21 @@ PYBIND11_MODULE(_rfem, m) {
       .def_readonly("warnings", &ModesStudy::warnings)
       .def_property_readonly("model", [](const ModesStudy& s) { return std::const_pointer_cast<Model>(s.model); });
   m.def("_modes", [](const Case& cs, int n, int count, const std::vector<std::string>& free, std::optional<double> rate,
-                     int joint) {
+                     int joint, const std::string& output) {
     ModesRequest rq;
     rq.n = n;
     rq.count = count;
     rq.free = free;
     rq.rate = joint_rate(rate, joint);
     py::gil_scoped_release release;
-    return std::make_shared<ModesStudy>(modes_study(cs, rq));
-  }, py::arg("case"), py::arg("n"), py::arg("count"), py::arg("free"), py::arg("rate"), py::arg("joint"));
+    auto s = std::make_shared<ModesStudy>(modes_study(cs, rq));
+    if (!output.empty()) {
+      ResultsWriter file(output, python_description(cs, "rfem.modes", "modes", s->model->n(), 1));
+      write_modes(file, *s);
+      file.close();
+    }
+    return s;
+  }, py::arg("case"), py::arg("n"), py::arg("count"), py::arg("free"), py::arg("rate"), py::arg("joint"), py::arg("output"));
 
   m.def("_refine", [](const Case& cs, const std::vector<int>& ns, const std::vector<std::string>& quantities,
                       const std::string& output, bool integration_check, std::optional<double> rate, int joint, int threads,

@@ -226,6 +226,41 @@ void ResultsWriter::write_refinement(const std::vector<std::string>& quantities,
   f.flush();
 }
 
+void ResultsWriter::write_table(const std::string& name, const Table& t, const std::vector<std::string>& columns,
+                                const std::vector<std::string>& units, const std::string& description) {
+  const h5::Quiet quiet;
+  File& f = *file_;
+  f.end_swmr();
+  if (static_cast<long>(t.data.size()) != t.rows * t.cols || static_cast<long>(columns.size()) != t.cols ||
+      static_cast<long>(units.size()) != t.cols)
+    throw std::invalid_argument("ResultsWriter::write_table: " + name + ": sizes do not agree");
+  f.require(kMargin + static_cast<long long>(t.data.size() * sizeof(double)));
+  const std::string what = f.what("writing " + name);
+  const hsize_t dims[2] = {static_cast<hsize_t>(t.rows), static_cast<hsize_t>(t.cols)};
+  const h5::Handle sp = h5::space(H5Screate_simple(2, dims, nullptr), what);
+  const h5::Handle lcpl = h5::plist(H5Pcreate(H5P_LINK_CREATE), what);
+  h5::check(H5Pset_create_intermediate_group(lcpl, 1), what);
+  const h5::Handle ds = h5::dataset(H5Dcreate2(f.id, name.c_str(), H5T_NATIVE_DOUBLE, sp, lcpl, H5P_DEFAULT, H5P_DEFAULT), what);
+  if (!t.data.empty()) h5::check(H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, t.data.data()), what);
+  h5::write_attribute(ds, "columns", columns);
+  h5::write_attribute(ds, "units", units);
+  h5::write_attribute(ds, "description", description);
+}
+
+void ResultsWriter::write_attribute(const std::string& object, const std::string& key, const std::string& value) {
+  const h5::Quiet quiet;
+  file_->end_swmr();
+  file_->attribute(object, key, value);
+}
+
+void ResultsWriter::write_attribute(const std::string& object, const std::string& key, const std::vector<std::string>& values) {
+  const h5::Quiet quiet;
+  File& f = *file_;
+  f.end_swmr();
+  const h5::Handle obj = h5::object(H5Oopen(f.id, object.c_str(), H5P_DEFAULT), f.what("opening " + object));
+  h5::write_attribute(obj, key, values);
+}
+
 // ---------------------------------------------------------------------------------------------
 
 struct RunWriter::Impl {
@@ -428,7 +463,7 @@ void RunWriter::append(const OutputSample& s) {
   if (now_s() - w.last_flush > 0.5) w.flush();
 }
 
-void RunWriter::finish(const RunOutcome& r, double wall_s) {
+void RunWriter::finish(const RunOutcome& r, double wall_s, const std::vector<std::string>& warnings) {
   const h5::Quiet quiet;
   Impl& w = *impl_;
   ResultsWriter::File& f = *w.file;
@@ -442,6 +477,9 @@ void RunWriter::finish(const RunOutcome& r, double wall_s) {
   f.pending.push_back({name, "newton_iters", static_cast<long>(r.stats.newton_iters)});
   f.pending.push_back({name, "newton_fails", static_cast<long>(r.stats.newton_fails)});
   f.pending.push_back({name, "error_test_fails", static_cast<long>(r.stats.error_test_fails)});
+  std::string lines;
+  for (const auto& x : warnings) lines += (lines.empty() ? "" : "\n") + x;
+  f.pending.push_back({name, "warnings", lines});
   w.set_status(r.status.to_string());
   w.flush();
   w.close_quietly();

@@ -13,6 +13,7 @@
 
 #include "rfem/results/errors.hpp"
 #include "rfem/results/layout.hpp"
+#include "rfem/results/reader.hpp"
 #include "rfem/solvers/integrator.hpp"
 #include "rfem/solvers/refinement.hpp"
 
@@ -59,6 +60,13 @@ class ResultsWriter {
   /// and its assessment; the first quantity's datasets also directly in `refine`.
   void write_refinement(const std::vector<std::string>& quantities, const std::vector<int>& ns,
                         const std::vector<Refinement>& tables, const RunStatus& status);
+  /// A table that does not grow (rows × columns, row-major), with its columns, units and
+  /// description; its groups are created as needed ("modes/shapes").
+  void write_table(const std::string& name, const Table& table, const std::vector<std::string>& columns,
+                   const std::vector<std::string>& units, const std::string& description);
+  /// String attributes of an object ("/", "modes").
+  void write_attribute(const std::string& object, const std::string& key, const std::string& value);
+  void write_attribute(const std::string& object, const std::string& key, const std::vector<std::string>& values);
   /// Flushes and closes the file; throws ResultsError if HDF5 cannot.
   void close();
 
@@ -75,8 +83,9 @@ class RunWriter {
   RunWriter(const RunWriter&) = delete;
   RunWriter& operator=(const RunWriter&) = delete;
   void append(const OutputSample& s);
-  /// Writes the status, the integrator's statistics and the wall time, and leaves SWMR mode.
-  void finish(const RunOutcome& outcome, double wall_s);
+  /// Writes the status, the integrator's statistics, the wall time and any warnings about the
+  /// solution (attribute `warnings`, one per line), and leaves SWMR mode.
+  void finish(const RunOutcome& outcome, double wall_s, const std::vector<std::string>& warnings = {});
   long samples() const;
 
   struct Impl;

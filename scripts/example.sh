@@ -17,3 +17,8 @@ build/apps/rfem static cases/kane_beam.toml
 build/apps/rfem modes cases/paper_link3.toml --n 60 --count 8
 build/apps/rfem modes cases/kane_spinup.toml --rate 6 --count 4
 /usr/bin/python3 examples/ex5_two_link_pd.py
+set +x
+echo
+echo "== done: built build/apps/rfem and the Python module (installed under ${RFEM_PREFIX:-/usr/local});"
+echo "   wrote paper_deployment.h5, two_link_arm.h5 and $(ls figures | wc -l) figures in figures/:"
+ls figures | sed 's/^/     /'

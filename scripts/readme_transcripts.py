@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""README transcripts: every block of README.md that follows a marker
+"""README transcripts: every block of README.md and docs/*.md that follows a marker
 
     <!-- transcript -->
     ```
@@ -17,6 +17,7 @@ of the README relies on; any other difference in text or digits is a mismatch.
 """
 import argparse
 import difflib
+import glob
 import os
 import re
 import shlex
@@ -58,34 +59,44 @@ def same(expected, got):
     return True
 
 
+def check(path, rfem, scratch, update):
+    """Checks (or rewrites) the transcripts of one Markdown file; returns (blocks, differing)."""
+    text = open(path).read()
+    name = os.path.relpath(path, ROOT)
+    bad = 0
+    out = []
+    pos = 0
+    for m in BLOCK.finditer(text):
+        got = run(m.group("cmd"), rfem, scratch)
+        out.append(text[pos:m.start("out")])
+        differs = not same(m.group("out"), got)
+        out.append(got if update and differs else m.group("out"))  # round-off stays as written
+        pos = m.end("out")
+        if differs:
+            bad += 1
+            if not update:
+                sys.stdout.writelines(difflib.unified_diff(m.group("out").splitlines(True), got.splitlines(True),
+                                                           name, m.group("cmd")))
+    out.append(text[pos:])
+    if update and bad:
+        open(path, "w").write("".join(out))
+    return len(BLOCK.findall(text)), bad
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--rfem", default=os.path.join(ROOT, "build", "apps", "rfem"))
     ap.add_argument("--update", action="store_true")
     args = ap.parse_args()
-    path = os.path.join(ROOT, "README.md")
-    text = open(path).read()
     scratch = tempfile.mkdtemp(prefix="rfem-readme-")
     os.symlink(os.path.join(ROOT, "cases"), os.path.join(scratch, "cases"))
-    bad = 0
-    out = []
-    pos = 0
-    for m in BLOCK.finditer(text):
-        got = run(m.group("cmd"), os.path.abspath(args.rfem), scratch)
-        out.append(text[pos:m.start("out")])
-        differs = not same(m.group("out"), got)
-        out.append(got if args.update and differs else m.group("out"))  # round-off stays as written
-        pos = m.end("out")
-        if differs:
-            bad += 1
-            if not args.update:
-                sys.stdout.writelines(difflib.unified_diff(m.group("out").splitlines(True), got.splitlines(True),
-                                                           "README.md", m.group("cmd")))
-    out.append(text[pos:])
+    files = [os.path.join(ROOT, "README.md")] + sorted(glob.glob(os.path.join(ROOT, "docs", "*.md")))
+    n = bad = 0
+    for path in files:
+        k, b = check(path, os.path.abspath(args.rfem), scratch, args.update)
+        n, bad = n + k, bad + b
     shutil.rmtree(scratch, ignore_errors=True)
-    n = len(BLOCK.findall(text))
     if args.update:
-        open(path, "w").write("".join(out))
         print(f"readme_transcripts: {n} transcripts, {bad} updated")
         return 0
     print(f"readme_transcripts: {n} transcripts, {bad} differ" + ("" if bad == 0 else ": run with --update"))

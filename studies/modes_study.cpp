@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "rfem/solvers/beam_theory.hpp"
+#include "rfem/studies/validity.hpp"
 
 namespace rfem {
 
@@ -89,12 +90,64 @@ ModesStudy modes_study(const Case& cs, const ModesRequest& rq) {
                                            i + 1, s.frequency_hz(i), ref.reference_hz));
     s.reference.push_back(ref);
   }
+  {  // modes about a state that is not small linearise about something the model does not describe
+    ValidityMonitor validity(model);
+    validity.check(s.modes.q0, NAN);
+    for (const auto& w : validity.warnings("the equilibrium the modes are about")) s.warnings.push_back(w);
+  }
   for (int i = 0; i < s.count; ++i)
     if (s.modes.uncertainty[i] > kUncertaintyTolerance)
       s.warnings.push_back(fmt::format("mode {}: two eigen-solutions with different shifts differ by {:.1e} of omega^2 "
                                        "(> {:.0e}): round-off of the stiff sdes at n = {}; fewer rfes give more accurate frequencies",
                                        i + 1, s.modes.uncertainty[i], kUncertaintyTolerance, model.n()));
   return s;
+}
+
+void write_modes(ResultsWriter& file, const ModesStudy& s) {
+  const Model& M = *s.model;
+  const int count = s.count, N = static_cast<int>(s.modes.shapes.rows());
+  // Column names of the coordinates in the model's order, then the free joints'.
+  std::vector<std::string> names(M.dof()), units(M.dof());
+  static const char* axis[6] = {"x1", "x2", "x3", "phi1", "phi2", "phi3"};
+  for (size_t l = 0; l < M.links.size(); ++l)
+    for (int k = 0; k < M.links[l].n(); ++k)
+      for (int a = 0; a < 6; ++a) {
+        names[M.rfe_index(static_cast<int>(l), k) + a] = fmt::format("{}.rfe{}.{}", M.links[l].name, k + 1, axis[a]);
+        units[M.rfe_index(static_cast<int>(l), k) + a] = a < 3 ? "m" : "rad";
+      }
+  for (int j = 0; j < M.m(); ++j) {
+    names[M.joint_index(j)] = M.joints[j].name;
+    units[M.joint_index(j)] = M.joints[j].type == JointType::Revolute ? "rad" : "m";
+  }
+  std::vector<std::string> cols(names.begin(), names.begin() + M.flexible_dofs()),
+      col_units(units.begin(), units.begin() + M.flexible_dofs());
+  for (int j : s.free) {
+    cols.push_back(names[M.joint_index(j)]);
+    col_units.push_back(units[M.joint_index(j)]);
+  }
+  Table shapes{count, N, std::vector<double>(static_cast<size_t>(count) * N)}, f{count, 1, {}}, w{count, 1, {}};
+  for (int i = 0; i < count; ++i) {
+    for (int r = 0; r < N; ++r) shapes.data[static_cast<size_t>(i) * N + r] = s.modes.shapes(r, i);
+    f.data.push_back(s.frequency_hz(i));
+    w.data.push_back(s.modes.omega[i]);
+  }
+  file.write_table("modes/frequency", f, {"f"}, {"Hz"}, "natural frequency of each mode (row)");
+  file.write_table("modes/omega", w, {"omega"}, {"rad/s"}, "natural circular frequency of each mode (row)");
+  file.write_table("modes/shapes", shapes, cols, col_units,
+                   "mode shapes, a row per mode: rfe coordinates (displacements from the equilibrium) and free joints, "
+                   "M-normalised");
+  const Table q0{1, M.dof(), std::vector<double>(s.modes.q0.data(), s.modes.q0.data() + s.modes.q0.size())};
+  file.write_table("modes/equilibrium", q0, names, units, "every coordinate of the state the modes are about");
+  for (const MountedLink& L : M.links) {
+    Table c{L.n(), 3, {}};
+    for (const Rfe& r : L.d.rfes) c.data.insert(c.data.end(), {r.centre[0], r.centre[1], r.centre[2]});
+    file.write_table("links/" + L.name + "/rfe_centre", c, {"x", "y", "z"}, {"m", "m", "m"},
+                     "undeformed mass centre of rfe k (row k-1) in {r}");
+  }
+  std::vector<std::string> kinds;
+  for (int i = 0; i < count; ++i) kinds.push_back(to_string(s.modes.kind[i]) + std::to_string(s.index_of_kind[i]));
+  file.write_attribute("modes", "kinds", kinds);
+  file.write_attribute("modes", "free_joints", s.free_names.empty() ? std::vector<std::string>{"(none)"} : s.free_names);
 }
 
 }  // namespace rfem

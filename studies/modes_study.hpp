@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "rfem/results/writer.hpp"
 #include "rfem/solvers/modes.hpp"
 #include "rfem/studies/common.hpp"
 
@@ -44,5 +45,11 @@ struct ModesStudy {
 
 /// Throws CaseError for a case without a flexible link or a bad --free.
 ModesStudy modes_study(const Case& cs, const ModesRequest& request);
+
+/// Writes the modes into a results file: group `modes` with `frequency` (Hz), `omega` (rad/s),
+/// `shapes` (a row per mode over the rfe coordinates and the free joints, columns named
+/// LINK.rfeK.x1 … phi3, M-normalised), `equilibrium` (every coordinate of the state they are about)
+/// and each link's `links/NAME/rfe_centre`; attributes `kinds` and `free_joints`.
+void write_modes(ResultsWriter& file, const ModesStudy& s);
 
 }  // namespace rfem

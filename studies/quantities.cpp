@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 
@@ -50,8 +51,9 @@ void parse_static(const Case& cs, const std::string& text, Quantity& s) {
   }
   if (what != "mode" && what != "axial" && what != "bending-y" && what != "bending-z" && what != "torsion")
     throw CaseError("--quantity " + quantity + ": unknown quantity '" + what +
-                    "' ([LINK/]tip:ux…rz, mode:K, axial:K, bending-y:K, bending-z:K, torsion:K, "
-                    "[RUN/][LINK/]peak:u1|u2|theta, [RUN/][LINK/]u1@T, u2@T, theta@T, [RUN/]tauJ@T, qJ@T)");
+                    "' ([LINK/]tip:ux…rz, mode:K, axial:K, bending-y:K, bending-z:K, torsion:K; dynamic: "
+                    "peak|max|min|rms|mean:SERIES[t1:t2] or SERIES@T, SERIES = [RUN/][LINK/]u1|u2|theta|tauJ|qJ|vJ|aJ "
+                    "or the difference of two)");
   size_t used = 0;
   try {
     s.mode = std::stoi(arg, &used);
@@ -64,63 +66,126 @@ void parse_static(const Case& cs, const std::string& text, Quantity& s) {
   s.mode_kind = what;
 }
 
-// Returns false if `quantity` is not dynamic; throws CaseError if it is but cannot be evaluated.
-bool parse_dynamic(const Case& cs, const std::string& quantity, Quantity& d) {
+// One series of a dynamic quantity: [RUN/][LINK/]NAME. Returns "" or why it is not one.
+std::string parse_term(const Case& cs, const std::string& text, QuantityTerm& t) {
   const bool paper = cs.sim.procedure == Procedure::Paper;
-  const bool prefixed = quantity.find('/') != std::string::npos;
-  const std::string q = split_prefixes(cs, quantity, d.run, d.link);
-  if (d.run.empty()) d.run = paper ? "kinematic" : "run";
-  std::string what;
-  if (q.rfind("peak:", 0) == 0) {
-    what = q.substr(5);
-    d.kind = Quantity::Kind::Peak;
-  } else if (const auto at = q.find('@'); at != std::string::npos) {
-    what = q.substr(0, at);
-    d.kind = Quantity::Kind::AtTime;
+  std::string name;
+  try {
+    name = split_prefixes(cs, text, t.run, t.link);
+  } catch (const CaseError& e) {
+    return e.what();
+  }
+  if (t.run.empty()) t.run = paper ? "kinematic" : "run";
+  const bool joint_name = name.size() > 1 && (name.rfind("tau", 0) == 0 || ((name[0] == 'q' || name[0] == 'v' || name[0] == 'a') &&
+                                                                        std::isdigit(static_cast<unsigned char>(name[1]))));
+  if (joint_name) {
+    const std::string num = name.substr(name[0] == 't' ? 3 : 1);
     size_t used = 0;
     try {
-      d.time = std::stod(q.substr(at + 1), &used);
+      t.joint = std::stoi(num, &used);
     } catch (...) {
       used = 0;
     }
-    if (used == 0 || used != q.size() - at - 1 || !std::isfinite(d.time))
-      throw CaseError("--quantity " + quantity + ": '" + q.substr(at + 1) + "' is not a time");
+    if (used == 0 || used != num.size() || t.joint < 1 || t.joint > static_cast<int>(cs.joints.size()))
+      return "joint must be 1.." + std::to_string(cs.joints.size());
+    t.joint_value = name[0];
+    if (t.link >= 0) return "joint quantities name no link";
+  } else if (name == "u1" || name == "u2" || name == "theta") {
+    if (cs.links.empty()) return "the case has no flexible link";
+    t.component = name == "u1" ? 0 : name == "u2" ? 1 : 2;
   } else {
-    if (prefixed && q.rfind("tip:", 0) != 0) throw CaseError("--quantity " + quantity + ": expected RUN/peak:X or RUN/X@T");
-    return false;
+    return "expected u1, u2, theta, tauJ, qJ, vJ or aJ (got '" + name + "')";
   }
-  if (what.rfind("tau", 0) == 0 || (what.size() > 1 && what[0] == 'q' && std::isdigit(static_cast<unsigned char>(what[1])))) {
-    const std::string num = what.substr(what[0] == 'q' ? 1 : 3);
-    d.joint = num.empty() ? 0 : std::atoi(num.c_str());
-    if (d.joint < 1 || d.joint > static_cast<int>(cs.joints.size()))
-      throw CaseError("--quantity " + quantity + ": joint must be 1.." + std::to_string(cs.joints.size()));
-    d.coordinate = what[0] == 'q';
-    if (d.link >= 0) throw CaseError("--quantity " + quantity + ": joint quantities name no link");
-  } else if (what != "u1" && what != "u2" && what != "theta") {
-    throw CaseError("--quantity " + quantity + ": expected u1, u2, theta, tauJ or qJ");
-  } else if (cs.links.empty()) {
-    throw CaseError("--quantity " + quantity + ": the case has no flexible link");
-  } else {
-    d.component = what == "u1" ? 0 : what == "u2" ? 1 : 2;
-  }
-  if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: a dynamic quantity needs a [simulation] table");
-  const bool known = paper ? (d.run == "rigid" || d.run == "kinematic" || d.run == "force") : d.run == "run";
+  const bool known = paper ? (t.run == "rigid" || t.run == "kinematic" || t.run == "force") : t.run == "run";
   if (!known) {
     std::string links;
     for (const LinkCase& lc : cs.links) links += (links.empty() ? "" : ", ") + lc.name;
-    throw CaseError("--quantity " + quantity + ": no run or link named '" + d.run + "' (" +
-                    (paper ? "the paper procedure runs rigid, kinematic and force" : "a single run is named run") +
-                    (cs.links.empty() ? std::string() : "; links: " + links) + ")");
+    return "no run or link named '" + t.run + "' (" +
+           (paper ? "the paper procedure runs rigid, kinematic and force" : "a single run is named run") +
+           (cs.links.empty() ? std::string() : "; links: " + links) + ")";
   }
+  return "";
+}
+
+double number_in(const std::string& quantity, const std::string& text, const char* what) {
+  size_t used = 0;
+  double v = NAN;
+  try {
+    v = std::stod(text, &used);
+  } catch (...) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(v))
+    throw CaseError("--quantity " + quantity + ": '" + text + "' is not " + what);
+  return v;
+}
+
+// Returns false if `quantity` is not dynamic; throws CaseError if it is but cannot be evaluated.
+bool parse_dynamic(const Case& cs, const std::string& quantity, Quantity& d) {
+  static const std::pair<const char*, Quantity::Aggregate> aggregates[] = {
+      {"peak", Quantity::Aggregate::Peak}, {"max", Quantity::Aggregate::Max}, {"min", Quantity::Aggregate::Min},
+      {"rms", Quantity::Aggregate::Rms}, {"mean", Quantity::Aggregate::Mean}};
+  std::string series;
+  const auto colon = quantity.find(':');
+  bool aggregate = false;
+  if (colon != std::string::npos) {  // AGG:SERIES, or the older PREFIX/AGG:NAME
+    const std::string head = quantity.substr(0, colon);
+    const auto slash = head.rfind('/');
+    const std::string word = slash == std::string::npos ? head : head.substr(slash + 1);
+    for (const auto& [w, a] : aggregates)
+      if (word == w) {
+        aggregate = true;
+        d.aggregate = a;
+      }
+    if (aggregate) series = (slash == std::string::npos ? std::string() : head.substr(0, slash + 1)) + quantity.substr(colon + 1);
+  }
+  if (!cs.has_simulation && (aggregate || quantity.find('@') != std::string::npos))
+    throw CaseError(cs.path + ": simulation: a dynamic quantity needs a [simulation] table");
   const IntegratorOptions& o = cs.sim.options;
-  if (d.time >= 0) {
+  if (aggregate) {
+    d.kind = Quantity::Kind::Aggregate;
+    d.t1 = 0.0;
+    d.t2 = o.t_end;
+    if (!series.empty() && series.back() == ']') {  // a window [t1:t2]
+      const auto lb = series.rfind('['), sep = series.find(':', lb == std::string::npos ? 0 : lb);
+      if (lb == std::string::npos || sep == std::string::npos)
+        throw CaseError("--quantity " + quantity + ": a window is [t1:t2] (seconds)");
+      d.t1 = number_in(quantity, series.substr(lb + 1, sep - lb - 1), "a time");
+      d.t2 = number_in(quantity, series.substr(sep + 1, series.size() - sep - 2), "a time");
+      series.resize(lb);
+      if (!(d.t1 >= 0.0 && d.t1 < d.t2 && d.t2 <= o.t_end * (1 + 1e-12)))
+        throw CaseError("--quantity " + quantity + ": the window must lie in the run, 0 ≤ t1 < t2 ≤ " + fmt::format("{}", o.t_end) + " s");
+      if (std::floor(d.t2 / o.output_dt + 1e-9) - std::ceil(d.t1 / o.output_dt - 1e-9) < 1)
+        throw CaseError("--quantity " + quantity + ": the window holds fewer than two outputs (every " +
+                        fmt::format("{}", o.output_dt) + " s)");
+    }
+  } else if (const auto at = quantity.rfind('@'); at != std::string::npos) {
+    d.kind = Quantity::Kind::AtTime;
+    d.time = number_in(quantity, quantity.substr(at + 1), "a time");
+    series = quantity.substr(0, at);
     const double k = std::round(d.time / o.output_dt);
     const bool on_grid = std::abs(d.time - k * o.output_dt) <= 1e-9 * std::max(1.0, d.time) || d.time == o.t_end;
-    if (d.time > o.t_end * (1 + 1e-12) || !on_grid)
+    if (d.time < 0 || d.time > o.t_end * (1 + 1e-12) || !on_grid)
       throw CaseError("--quantity " + quantity + ": t = " + fmt::format("{}", d.time) + " s is not an output time (0 … " +
                       fmt::format("{}", o.t_end) + " s every " + fmt::format("{}", o.output_dt) + " s)");
+  } else {
+    if (quantity.find('/') != std::string::npos && quantity.find("tip:") == std::string::npos)
+      throw CaseError("--quantity " + quantity + ": expected AGG:[RUN/]NAME (peak:force/u1) or [RUN/]NAME@T");
+    return false;
   }
-  return true;
+  // SERIES = TERM or TERM-TERM: the first '-' that leaves two terms (names may hold '-').
+  QuantityTerm a, b;
+  const std::string one = parse_term(cs, series, a);
+  if (one.empty()) {
+    d.terms = {a};
+    return true;
+  }
+  for (size_t dash = series.find('-'); dash != std::string::npos; dash = series.find('-', dash + 1))
+    if (parse_term(cs, series.substr(0, dash), a).empty() && parse_term(cs, series.substr(dash + 1), b).empty()) {
+      d.terms = {a, b};
+      return true;
+    }
+  throw CaseError("--quantity " + quantity + ": " + one);
 }
 
 }  // namespace
@@ -169,9 +234,64 @@ double evaluate_quantity(const Case& cs, int n, const std::string& text, const J
   return evaluate_quantity(cs, n, parse_quantity(cs, text), rate);
 }
 
-double sample_value(const Model& m, const Quantity& d, const OutputSample& s) {
-  if (d.joint > 0) return d.coordinate ? s.q[m.joint_index(d.joint - 1)] : s.tau[d.joint - 1];
-  return tip_deflection(m, d.link >= 0 ? d.link : static_cast<int>(m.links.size()) - 1, s.q)[d.component];
+double term_value(const Model& m, const QuantityTerm& t, const OutputSample& s) {
+  if (t.joint > 0) {
+    const int i = m.joint_index(t.joint - 1);
+    switch (t.joint_value) {
+      case 'q': return s.q[i];
+      case 'v': return s.v[i];
+      case 'a': return s.a[i];
+      default: return s.tau[t.joint - 1];
+    }
+  }
+  return tip_deflection(m, t.link >= 0 ? t.link : static_cast<int>(m.links.size()) - 1, s.q)[t.component];
+}
+
+double dynamic_value(const Quantity& q, const std::vector<double>& t, const std::vector<std::vector<double>>& series) {
+  if (series.size() != q.terms.size()) throw std::invalid_argument("dynamic_value: one series per term is required");
+  auto x = [&](size_t i) { return series[0][i] - (series.size() > 1 ? series[1][i] : 0.0); };
+  const size_t n = t.size();
+  for (const auto& s : series)
+    if (s.size() != n) throw std::invalid_argument("dynamic_value: the series and the times differ in length");
+  if (n == 0) return NAN;
+  if (q.kind == Quantity::Kind::AtTime) {
+    size_t best = 0;
+    for (size_t i = 1; i < n; ++i)
+      if (std::abs(t[i] - q.time) < std::abs(t[best] - q.time)) best = i;
+    return x(best);
+  }
+  double peak = 0.0, hi = -INFINITY, lo = INFINITY, integral = 0.0, square = 0.0, span = 0.0;
+  long prev = -1;
+  for (size_t i = 0; i < n; ++i) {
+    if (t[i] < q.t1 - 1e-9 * std::max(1.0, q.t1) || t[i] > q.t2 + 1e-9 * std::max(1.0, q.t2)) continue;
+    const double v = x(i);
+    peak = std::max(peak, std::abs(v));
+    hi = std::max(hi, v);
+    lo = std::min(lo, v);
+    if (prev >= 0) {  // trapezoidal time average over the outputs in the window
+      const double dt = t[i] - t[prev], u = x(prev);
+      integral += 0.5 * (u + v) * dt;
+      square += 0.5 * (u * u + v * v) * dt;
+      span += dt;
+    }
+    prev = static_cast<long>(i);
+  }
+  switch (q.aggregate) {
+    case Quantity::Aggregate::Peak: return peak;
+    case Quantity::Aggregate::Max: return hi;
+    case Quantity::Aggregate::Min: return lo;
+    case Quantity::Aggregate::Mean: return span > 0 ? integral / span : NAN;
+    case Quantity::Aggregate::Rms: return span > 0 ? std::sqrt(square / span) : NAN;
+  }
+  return NAN;
+}
+
+std::vector<std::string> runs_read(const std::vector<Quantity>& qs) {
+  std::vector<std::string> runs;
+  for (const Quantity& q : qs)
+    for (const QuantityTerm& t : q.terms)
+      if (std::find(runs.begin(), runs.end(), t.run) == runs.end()) runs.push_back(t.run);
+  return runs;
 }
 
 }  // namespace rfem

@@ -1,11 +1,15 @@
 #pragma once
-// The scalar quantities of a refinement study, typed: static tips, modal frequencies, and dynamic
-// peaks or values at an output time of a run of the case's procedure (README, `rfem refine`).
-//   [LINK/]tip:ux|uy|uz|rx|ry|rz           static tip of a link (default: the last)
-//   mode:K, axial:K, bending-y:K, bending-z:K, torsion:K    K-th frequency (of that kind) [Hz]
-//   [RUN/][LINK/]peak:u1|u2|theta          peak |tip deflection| over a run
-//   [RUN/][LINK/]u1@T, u2@T, theta@T       tip deflection at output time T
-//   [RUN/]tauJ@T, qJ@T                     torque or coordinate of joint J (from 1) at T
+// The scalar quantities of a refinement study, typed (README, "Quantities", has the table):
+//   static and modal:  [LINK/]tip:ux|uy|uz|rx|ry|rz     static tip of a link (default: the last)
+//                      mode:K, axial:K, bending-y:K, bending-z:K, torsion:K   K-th frequency [Hz]
+//   dynamic:           AGG:SERIES[WINDOW]   AGG = peak (max |x|), max, min, rms, mean over the run
+//                                            or over WINDOW = [t1:t2] (times in s)
+//                      SERIES@T             the value at output time T
+//   SERIES = TERM or TERM-TERM (a difference of two runs' series at the same times), and
+//   TERM = [RUN/][LINK/]NAME with NAME = u1, u2, theta (a link's tip deflections) or tauJ, qJ, vJ, aJ
+//   (torque, coordinate, rate, acceleration of joint J from 1); RUN defaults to the procedure's
+//   main run (kinematic for the paper's, run for a single one). Fig. 6's point, the torque the
+//   flexibility adds, is peak:kinematic/tau3-rigid/tau3.
 #include <string>
 #include <vector>
 
@@ -14,35 +18,52 @@
 
 namespace rfem {
 
+/// One series a dynamic quantity reads from a run.
+struct QuantityTerm {
+  std::string run;      ///< run, rigid, kinematic, force
+  int link = -1;        ///< tip deflections: the link (−1: the last)
+  int component = 0;    ///< tip deflections: 0 u1, 1 u2, 2 θ
+  int joint = -1;       ///< joint series: the joint (1-based); −1: a tip deflection
+  char joint_value = 0; ///< 't' torque, 'q' coordinate, 'v' rate, 'a' acceleration
+  bool operator==(const QuantityTerm& o) const {
+    return run == o.run && link == o.link && component == o.component && joint == o.joint && joint_value == o.joint_value;
+  }
+};
+
 struct Quantity {
   enum class Kind {
     Tip,         ///< static tip component `component` (0–5) of link `link`
     Mode,        ///< the K-th frequency
     ModeOfKind,  ///< the K-th frequency of kind `mode_kind`
-    Peak,        ///< peak |value| over a run
-    AtTime,      ///< the value at output time `time`
+    Aggregate,   ///< `aggregate` of the series over [t1, t2]
+    AtTime,      ///< the series at output time `time`
   };
+  enum class Aggregate { Peak, Max, Min, Rms, Mean };
   std::string text;       ///< as given
   Kind kind = Kind::Tip;
-  int link = -1;          ///< tip quantities: the link (−1: the last)
-  int component = 0;      ///< Tip: 0–5; Peak/AtTime on a tip: 0 u1, 1 u2, 2 θ
+  int link = -1;          ///< Tip: the link (−1: the last)
+  int component = 0;      ///< Tip: 0–5
   int mode = 0;           ///< Mode, ModeOfKind: K ≥ 1
   std::string mode_kind;  ///< ModeOfKind: axial, bending-y, bending-z, torsion
-  std::string run;        ///< dynamic: the run's name (run, rigid, kinematic, force)
-  int joint = -1;         ///< dynamic joint quantities: the joint (1-based); −1: a tip quantity
-  bool coordinate = false;///< joint quantity: q (else the torque τ)
-  double time = -1.0;     ///< AtTime: [s]
-  bool dynamic() const { return kind == Kind::Peak || kind == Kind::AtTime; }
+  Aggregate aggregate = Aggregate::Peak;
+  std::vector<QuantityTerm> terms;  ///< dynamic: one, or two (the first minus the second)
+  double time = -1.0;               ///< AtTime [s]
+  double t1 = 0.0, t2 = 0.0;        ///< Aggregate: the window [s] (the whole run by default)
+  bool dynamic() const { return kind == Kind::Aggregate || kind == Kind::AtTime; }
 };
 
-/// Parses and checks a quantity against the case (a T off the output grid, an unknown run, link
-/// or joint): CaseError with a one-line message.
+/// Parses and checks a quantity against the case (a T off the output grid, a window outside the
+/// run, an unknown run, link or joint): CaseError with a one-line message.
 Quantity parse_quantity(const Case& cs, const std::string& text);
 /// A static or modal quantity at n rfes.
 double evaluate_quantity(const Case& cs, int n, const Quantity& q, const JointRate& rate = {});
 /// The same from its text.
 double evaluate_quantity(const Case& cs, int n, const std::string& text, const JointRate& rate = {});
-/// A dynamic quantity's value in one output sample of its run (peaks take the |value|'s maximum).
-double sample_value(const Model& model, const Quantity& q, const OutputSample& s);
+/// A term's value in one output sample of its run.
+double term_value(const Model& model, const QuantityTerm& term, const OutputSample& s);
+/// A dynamic quantity from its terms' series (`series[i]` of terms[i], sampled at `times`).
+double dynamic_value(const Quantity& q, const std::vector<double>& times, const std::vector<std::vector<double>>& series);
+/// The runs the quantities read (what a study must run).
+std::vector<std::string> runs_read(const std::vector<Quantity>& qs);
 
 }  // namespace rfem

@@ -19,7 +19,7 @@ void Hdf5Recorder::end(const RunResult& r) {
   o.status = r.status;
   o.t_reached = r.t_reached;
   o.stats = r.stats;
-  run_->finish(o, r.wall_s);
+  run_->finish(o, r.wall_s, r.warnings);
 }
 
 FileDescription describe(const Case& cs, const std::string& command_line, const std::string& procedure, long n,

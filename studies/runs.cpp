@@ -7,6 +7,7 @@
 
 #include "rfem/core/positions.hpp"
 #include "rfem/studies/inputs.hpp"
+#include "rfem/studies/validity.hpp"
 
 namespace rfem {
 
@@ -62,6 +63,7 @@ RunResult run_one(const std::string& name, std::shared_ptr<const Model> model, c
   std::vector<std::vector<double>> rows;
   double balance0 = NAN;
   const Model& m = *model;
+  ValidityMonitor validity(m);
   auto sink = [&](const OutputSample& x) {
     for (RunObserver* obs : rq.observers) obs->sample(x);
     if (RunSeries* ser = s.series.get()) {
@@ -81,6 +83,7 @@ RunResult run_one(const std::string& name, std::shared_ptr<const Model> model, c
       pk.u2 = std::max(pk.u2, std::abs(u[1]));
       pk.theta = std::max(pk.theta, std::abs(u[2]));
     }
+    validity.check(x.q, x.t);
     const double bal = x.energy_balance();
     if (std::isnan(balance0)) balance0 = bal;
     s.energy_drift = std::max(s.energy_drift, std::abs(bal - balance0));
@@ -102,6 +105,9 @@ RunResult run_one(const std::string& name, std::shared_ptr<const Model> model, c
   s.status = r.status;
   s.stats = r.stats;
   s.t_reached = r.t_reached;
+  s.warnings = validity.warnings("run " + name);
+  if (rq.warn)
+    for (const auto& w : s.warnings) rq.warn(w);
   for (RunObserver* obs : rq.observers) obs->end(s);
   return s;
 }

@@ -55,6 +55,8 @@ struct RunResult {
   /// max |balance(t) − balance(0)| with balance = T + V + dissipated − input work [J], and the
   /// largest of T, |V_e|, |input work| for scale.
   double energy_drift = 0, energy_scale = 0;
+  /// Where the solution left the range the model is built on (studies/validity.hpp), one line each.
+  std::vector<std::string> warnings;
   std::shared_ptr<const Model> model;   ///< the model it ran (rigidified for `rigid`)
   std::shared_ptr<RunSeries> series;    ///< null unless the request keeps series
   bool completed() const { return status.is_completed(); }

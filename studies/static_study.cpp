@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "rfem/studies/validity.hpp"
+
 namespace rfem {
 
 StaticStudy static_study(const Case& cs, int n, const JointRate& rate) {
@@ -18,6 +20,9 @@ StaticStudy static_study(const Case& cs, int n, const JointRate& rate) {
                              " J, gravity energy " + std::to_string(s.energies.gravity) + " J): check the case's values");
   for (int l = 0; l < static_cast<int>(model.links.size()); ++l)
     s.tips.push_back({model.links[l].name, model.links[l].n(), tip_motion(model, l, s.solution.q)});
+  ValidityMonitor validity(model);
+  validity.check(s.solution.q, NAN);
+  s.warnings = validity.warnings("static equilibrium");
   return s;
 }
 

@@ -22,6 +22,7 @@ struct StaticStudy {
   StaticResult solution;
   std::vector<LinkTip> tips;  ///< every link's
   Energies energies;          ///< at rest: elastic and gravity
+  std::vector<std::string> warnings;  ///< an equilibrium beyond the small deformation the model assumes
 };
 
 /// Throws CaseError without a flexible link, std::runtime_error if no finite equilibrium is found.

@@ -113,7 +113,7 @@ g = h5py.File('nan_run.h5')['run']
 sys.exit(0 if all(np.isfinite(g[k][()]).all() for k in ('joint_q', 'joint_v', 'joint_a', 'energy')) else 1)" \
   && ok "no NaN among the rows it kept" || bad "NaN rows in nan_run.h5"
 "$rfem" modes "$src/cases/kane_hub_drive.toml" --set materials.kane.rho=1e308 --count 1 > out.txt 2> err.txt; code=$?
-one_line 1 "modes with rho = 1e308"
+one_line 2 "modes with rho = 1e308 (refused at reading)"
 grep -qiE "nan|inf" out.txt && bad "modes printed nan or inf: $(cat out.txt)" || ok "modes printed no nan or inf"
 
 # 5. Bounded work: an output interval of 1e-18 s is refused at once (once: SIGTERM ignored, 5 GB).

@@ -3,7 +3,9 @@
 
     /usr/bin/python3 tools/rfem_plot.py RESULT.h5 [-o OUTDIR]
 
-Writes PNGs into OUTDIR (default: the directory of RESULT.h5):
+    /usr/bin/python3 tools/rfem_plot.py RESULT.h5 [-o OUTDIR] [--format png|pdf|svg] [--paper-signs]
+
+Writes figures (PNG by default) into OUTDIR (default: the directory of RESULT.h5):
   * for every run group G: G_joints.png, G_tip.png, G_energy.png, and G_momentum.png on a free
     base (linear and angular momentum: constant without gravity);
   * for procedure "paper": fig5_tip.png, fig6_torque3.png, fig7_velocity3.png, fig8_accel12.png
@@ -106,8 +108,17 @@ def mean_acceleration(t, v):
     return t[1:-1], (v[2:] - v[:-2]) / (t[2:] - t[:-2])[:, None] if v.ndim == 2 else (v[2:] - v[:-2]) / (t[2:] - t[:-2])
 
 
+FORMAT = "png"       # --format: png, pdf or svg
+PAPER_SIGNS = False  # --paper-signs: u1, u2 with the sign of the paper (Kane's), not the physical one
+
+
+def tip_sign(j):
+    """The sign the tip deflection j (u1, u2, θ) is drawn with."""
+    return -1.0 if PAPER_SIGNS and j < 2 else 1.0
+
+
 def save(fig, outdir, name):
-    path = os.path.join(outdir, name)
+    path = os.path.join(outdir, os.path.splitext(name)[0] + "." + FORMAT)
     fig.savefig(path, dpi=DPI)
     plt.close(fig)
     print("wrote %s" % path)
@@ -145,13 +156,15 @@ def plot_run(run, outdir):
         axes[0, 0].set_title(run.title("joint coordinates, rates and torques"))
         fig.tight_layout()
         save(fig, outdir, "%s_joints.png" % g)
-    # Tip deflections (of every link: one colour per link).
-    if run.tips:
+    # Tip deflections (of every link: one colour per link); a run with every link rigid has none.
+    if run.tips and run.n == 0:
+        print("rfem plot: note: run %s has rigid links only: no tip deflections to draw" % g, file=sys.stderr)
+    if run.tips and run.n != 0:
         scale = max(np.max(np.abs(td[:, :2])) if td.size else 0.0 for _, td in run.tips)
         fig, axes = plt.subplots(3, 1, sharex=True, figsize=(8, 7))
         for j, (ax, (name, ylabel)) in enumerate(zip(axes, TIP_LABELS)):
             for i, (link, td) in enumerate(run.tips):
-                y = td[:, j]
+                y = tip_sign(j) * td[:, j]
                 label = "%s %s" % (name, link) if link else name
                 color = "C%d" % (i if len(run.tips) > 1 else j)
                 if negligible(y, scale if j < 2 else max(scale, np.max(np.abs(y)) * 1e13)):
@@ -163,7 +176,8 @@ def plot_run(run, outdir):
                     ax.plot(run.t, y, label=label, color=color)
             finish(ax, ylabel=ylabel)
         axes[-1].set_xlabel("t [s]")
-        axes[0].set_title(run.title("tip deflections u1, u2 and torsion θ" + (" of every link" if len(run.tips) > 1 else "")))
+        axes[0].set_title(run.title("tip deflections u1, u2 and torsion θ" + (" of every link" if len(run.tips) > 1 else "") +
+                                    (" (the paper's signs)" if PAPER_SIGNS else "")))
         fig.tight_layout()
         save(fig, outdir, "%s_tip.png" % g)
     # Energy and the drift of the balance.
@@ -216,10 +230,11 @@ def plot_paper(runs, outdir):
     # Fig. 5: tip deflections, kinematic vs force input.
     fig, axes = plt.subplots(3, 1, sharex=True, figsize=(8, 7.5))
     for j, (ax, (_, ylabel)) in enumerate(zip(axes, TIP_LABELS)):
-        compare(ax, [(kin.t, kin.col("tip_deflection", j), "kinematic input"),
-                     (frc.t, frc.col("tip_deflection", j), "force input")], ylabel)
+        compare(ax, [(kin.t, tip_sign(j) * kin.col("tip_deflection", j), "kinematic input"),
+                     (frc.t, tip_sign(j) * frc.col("tip_deflection", j), "force input")], ylabel)
     axes[-1].set_xlabel("t [s]")
-    axes[0].set_title(head + "Fig. 5: tip deflections u1, u2 and torsion θ of link 3" + status_note(kin, frc))
+    axes[0].set_title(head + "Fig. 5: tip deflections u1, u2 and torsion θ of link 3" +
+                      (" (the paper's signs)" if PAPER_SIGNS else "") + status_note(kin, frc))
     fig.tight_layout()
     save(fig, outdir, "fig5_tip.png")
     # Fig. 6: joint-3 torque, rigid vs flexible link.
@@ -251,26 +266,28 @@ def plot_paper(runs, outdir):
     save(fig, outdir, "fig8_accel12.png")
 
 
-def quantity_unit(q):
-    """The unit of a refine quantity (see README, rfem refine)."""
+def quantity_unit(q, joint_units=()):
+    """The unit of a refine quantity (README, "Quantities"); joint_units: "rad" or "m" per joint."""
     name = q.split("/")[-1]
     if name.startswith(("mode:", "axial:", "bending-", "torsion:")):
         return "Hz"
     if name.startswith("tip:"):
         return "m" if name[4:5] == "u" else "rad"
-    body = name.split(":")[-1].split("@")[0]
+    body = name.split(":")[-1].split("@")[0].split("[")[0].split("-")[0]
     if body in ("u1", "u2"):
         return "m"
     if body == "theta":
         return "rad"
-    if body.startswith("tau"):
-        return "N m or N"
-    if body.startswith("q"):
-        return "rad or m"
+    for prefix, units in (("tau", ("N m", "N")), ("q", ("rad", "m")), ("v", ("rad/s", "m/s")), ("a", ("rad/s²", "m/s²"))):
+        if body.startswith(prefix) and body[len(prefix):].isdigit():
+            j = int(body[len(prefix):]) - 1
+            if 0 <= j < len(joint_units):
+                return units[0] if joint_units[j] == "rad" else units[1]
+            return " or ".join(units)
     return ""
 
 
-def plot_refine(group, outdir, case_name=""):
+def plot_refine(group, outdir, case_name="", joint_units=()):
     """Per quantity: |value − Richardson value| (when the series is trusted) or the successive
     changes, against n on log–log axes, with a line of the order fitted by least squares over all
     changes (independent of the extrapolation)."""
@@ -283,7 +300,7 @@ def plot_refine(group, outdir, case_name=""):
         v = np.asarray(g["value"][:], dtype=float).ravel()
         n = n_all[:len(v)]
         quantity = text_attr(g, "quantity", "value")
-        unit = quantity_unit(quantity)
+        unit = quantity_unit(quantity, joint_units)
         warnings = text_attr(g, "warnings", "")
         fitted = float(np.asarray(g.attrs.get("fitted_order", np.nan)).ravel()[0])
         if "reference" in g.attrs:
@@ -326,7 +343,13 @@ def main(argv=None):
     parser = argparse.ArgumentParser(prog="rfem_plot.py", description=__doc__.splitlines()[0])
     parser.add_argument("result", metavar="RESULT.h5", help="HDF5 file written by rfem")
     parser.add_argument("-o", "--outdir", help="output directory (default: that of RESULT.h5)")
+    parser.add_argument("--format", choices=("png", "pdf", "svg"), default="png",
+                        help="file format of the figures (pdf and svg scale for print)")
+    parser.add_argument("--paper-signs", action="store_true",
+                        help="draw u1, u2 with the paper's (Kane's) sign, the opposite of the physical displacement")
     args = parser.parse_args(argv)
+    global FORMAT, PAPER_SIGNS
+    FORMAT, PAPER_SIGNS = args.format, args.paper_signs
     outdir = args.outdir or os.path.dirname(os.path.abspath(args.result))
     try:
         if not os.path.isfile(args.result):
@@ -368,7 +391,10 @@ def main(argv=None):
                 plot_run(run, outdir)
             if has_refine:
                 case = text_attr(f, "case_path")
-                plot_refine(f["refine"], outdir, os.path.splitext(os.path.basename(case))[0] if case else "")
+                units = []  # the joints' units, from any run of the study (n12/run, …)
+                f.visititems(lambda name, obj: units.extend(list_attr(obj, "joint_units"))
+                             if not units and isinstance(obj, h5py.Group) and "joint_units" in obj.attrs else None)
+                plot_refine(f["refine"], outdir, os.path.splitext(os.path.basename(case))[0] if case else "", units)
     except (OSError, KeyError, ValueError, IndexError, TypeError) as exc:
         reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         print("rfem plot: error: %s: %s" % (args.result, reason), file=sys.stderr)

@@ -28,7 +28,7 @@ from . import _rfem
 from ._rfem import Case, CaseError, Model, ModesResult, ResultsError, Run, StaticResult, __version__, build
 
 __all__ = ["Case", "CaseError", "Model", "ModesResult", "ResultsError", "Run", "RunInterrupted", "Runs",
-           "StaticResult", "RefineResult", "load", "model", "run", "static", "modes", "refine", "plot",
+           "StaticResult", "RefineResult", "Tree", "load", "model", "show", "run", "static", "modes", "refine", "plot",
            "toml_value", "__version__"]
 
 
@@ -135,6 +135,26 @@ def run(case, n=None, output=None, runs=None, threads=0, keep_series=True, progr
     return result
 
 
+class Tree(list):
+    """The assembled tree of a case (rfem.show): one dict per joint, link and payload — kind, name,
+    depth, parent, where (on a link), mass [kg], length [m], rfes, detail (type, axis, input,
+    segments), coordinates (which entries of q) — depth first; str() is the text of `rfem show`."""
+
+    text = ""
+
+    def __str__(self):
+        return self.text
+
+
+def show(case, n=None):
+    """What the case builds, to check against its drawing: every joint, link and payload with
+    what it is mounted on and where, masses, rfes, coordinates and inputs. print(rfem.show(case))."""
+    text, entries = _rfem._show(case, n or 0)
+    tree = Tree(entries)
+    tree.text = text
+    return tree
+
+
 def static(case, n=None, rate=None, joint=1):
     """Static equilibrium with the joints held at their values (or turning steadily: `rate`
     [rad/s or m/s] of joint `joint`, from 1) under gravity and the case's tip loads. Returns a
@@ -142,12 +162,13 @@ def static(case, n=None, rate=None, joint=1):
     return _rfem._static(case, n or 0, rate, joint)
 
 
-def modes(case, n=None, count=6, free=(), rate=None, joint=1):
+def modes(case, n=None, count=6, free=(), rate=None, joint=1, output=None):
     """Natural frequencies and mode shapes of the flexible links about the static equilibrium,
     joints held except those in `free` (numbers from 1, names, or "base"), optionally in a frame
     turning at `rate` about joint `joint`. Returns a ModesResult (frequencies [Hz], kinds,
-    shapes, exact references for one uniform segment)."""
-    return _rfem._modes(case, n or 0, count, [str(f) for f in free], rate, joint)
+    shapes, exact references for one uniform segment); `output`: an HDF5 file with the
+    frequencies and shapes (group modes, as `rfem modes -o`)."""
+    return _rfem._modes(case, n or 0, count, [str(f) for f in free], rate, joint, _os.fspath(output) if output else "")
 
 
 class RefineResult(dict):
@@ -187,11 +208,12 @@ def _plot_script():
     raise FileNotFoundError("rfem_plot.py not found beside the rfem package (set RFEM_PLOT_SCRIPT)")
 
 
-def plot(results, outdir=None):
-    """The figures of `rfem plot` (PNG) for a results or refinement file (default directory: the
-    file's); returns the paths written. A file it cannot read raises RuntimeError with the
-    program's one-line message."""
-    cmd = [_sys.executable, _plot_script(), _os.fspath(results)] + (["-o", _os.fspath(outdir)] if outdir else [])
+def plot(results, outdir=None, format="png", paper_signs=False):
+    """The figures of `rfem plot` for a results or refinement file (default directory: the
+    file's; format png, pdf or svg; paper_signs: u1, u2 with the paper's sign); returns the paths
+    written. A file it cannot read raises RuntimeError with the program's one-line message."""
+    cmd = [_sys.executable, _plot_script(), _os.fspath(results), "--format", format] + \
+        (["-o", _os.fspath(outdir)] if outdir else []) + (["--paper-signs"] if paper_signs else [])
     p = _subprocess.run(cmd, capture_output=True, text=True)
     if p.returncode != 0:
         lines = [l for l in p.stderr.strip().splitlines() if l.startswith("rfem plot: error: ")] or p.stderr.strip().splitlines()

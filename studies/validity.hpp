@@ -1,0 +1,40 @@
+#pragma once
+// Whether a solution stays in the range the model is built on (docs/formulation.md §3): deformation
+// small relative to {r}. The sde law takes rotation differences Δφ as if they were small rotation
+// vectors and measures Δx in {r} axes; for an rfe turned by φ relative to {r} both err by terms of
+// relative size φ²/2 (cos φ ≈ 1 − φ²/2, and the axial/shear split of Δx turns by φ). At 0.1 rad that
+// is 0.5 %, at 0.3 rad 4.5 %: beyond kSmallRotation the results are approximate, and a warning says
+// where and when the solution left the range first, and how far it went.
+#include <string>
+#include <vector>
+
+#include "rfem/core/model.hpp"
+
+namespace rfem {
+
+/// The largest rotation of an rfe relative to {r} the model is trusted with [rad].
+inline constexpr double kSmallRotation = 0.1;
+
+class ValidityMonitor {
+ public:
+  explicit ValidityMonitor(const Model& model);
+  /// Looks at a state (full coordinates) at time t (NaN for a static state).
+  void check(const VecX& q, double t);
+  /// One warning per link whose rfes turned beyond kSmallRotation ("" context: "the solution").
+  std::vector<std::string> warnings(const std::string& context) const;
+  /// The largest rotation of an rfe of link l relative to {r} seen so far [rad].
+  double largest_rotation(int l) const { return links_[l].peak; }
+
+ private:
+  struct Link {
+    std::string name;
+    double length = 0.0;
+    double peak = 0.0, peak_t = 0.0, first_t = -1.0;
+    int peak_rfe = -1;
+    bool exceeded = false;
+  };
+  const Model& model_;
+  std::vector<Link> links_;
+};
+
+}  // namespace rfem
