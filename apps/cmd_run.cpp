@@ -5,6 +5,7 @@
 #include "commands.hpp"
 #include "progress.hpp"
 #include "signals.hpp"
+#include "rfem/results/xdmf.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/recorders.hpp"
 
@@ -78,6 +79,15 @@ int run_simulation(const Common& c, const std::string& output) {
   const std::vector<RunResult> runs = run_case(cs, model, inputs, rq);
   file.close();
   const RunResult& last = runs.back();
+  // ParaView's view of every run that stored its poses (also of a failed run: what it computed).
+  std::vector<std::string> xdmf;
+  if (cs.sim.flexible_every > 0 && model->n() > 0) {
+    try {
+      xdmf = write_xdmf(output);
+    } catch (const std::exception& e) {
+      print_warning(std::string("no ParaView file: ") + e.what());
+    }
+  }
   if (c.json) {
     nlohmann::json js = nlohmann::json::array();
     for (const auto& r : runs) {
@@ -92,9 +102,10 @@ int run_simulation(const Common& c, const std::string& output) {
       if (!r.peaks.empty())  // the last link's, as with one link
         js.back().update({{"peak_u1", r.peaks.back().u1}, {"peak_u2", r.peaks.back().u2}, {"peak_theta", r.peaks.back().theta}});
     }
-    print_json({{"command", "run"}, {"case", cs.path}, {"n", model->n()}, {"output", output}, {"runs", js}});
+    print_json({{"command", "run"}, {"case", cs.path}, {"n", model->n()}, {"output", output}, {"xdmf", xdmf}, {"runs", js}});
   } else if (!quiet) {
     fmt::print("results in {}\n", output);
+    for (const std::string& x : xdmf) fmt::print("ParaView: {}\n", x);
   }
   if (last.completed()) return 0;
   if (last.status.kind == RunStatus::Kind::Interrupted) return 128 + (last.status.signal > 0 ? last.status.signal : 2);

@@ -52,6 +52,11 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o);
 /// `rfem plot RESULTS.h5 [-o DIR]`: PNG figures of a results or refinement file.
 int run_plot(const std::string& results, const std::string& outdir, const std::string& format = "", bool paper_signs = false);
 
+/// `rfem animate RESULTS.h5 …`: the arm moving, as MP4 or GIF (options passed to rfem_animate.py).
+int run_animate(const std::vector<std::string>& args);
+/// `rfem view RESULTS.h5 [--run R]`: XDMF files for ParaView beside the results file.
+int run_view(const std::string& results, const std::vector<std::string>& runs);
+
 void print_json(const nlohmann::json& j);
 /// Prints "rfem: warning: …" on stderr.
 void print_warning(const std::string& w);

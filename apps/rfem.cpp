@@ -88,6 +88,22 @@ int main(int argc, char** argv) {
   bool paper_signs = false;
   pl->add_option("--format", plot_format, "png (default), pdf or svg")->check(CLI::IsMember({"png", "pdf", "svg"}));
   pl->add_flag("--paper-signs", paper_signs, "u1, u2 with the paper's (Kane's) sign, the opposite of the physical displacement");
+  auto* vw = app.add_subcommand("view", "ParaView (XDMF) files of a results file's runs that stored their poses");
+  std::string view_file;
+  std::vector<std::string> view_runs;
+  vw->add_option("results", view_file, "results file (HDF5) from rfem run with simulation.store_flexible_every > 0")->required();
+  vw->add_option("--run", view_runs, "only these runs (default: every run with poses)")->delimiter(',');
+  auto* an = app.add_subcommand("animate", "the arm moving (MP4 with ffmpeg, or GIF) from a run that stored its poses");
+  std::string anim_file, anim_out, anim_run, anim_view;
+  double anim_scale = 0;
+  int anim_fps = 0, anim_frames = 0;
+  an->add_option("results", anim_file, "results file (HDF5) from rfem run with simulation.store_flexible_every > 0")->required();
+  an->add_option("-o,--output", anim_out, "FILE.mp4 or FILE.gif (default: RESULT.RUN.mp4, .gif without ffmpeg)");
+  an->add_option("--run", anim_run, "run (default: the last one with poses)");
+  an->add_option("--scale", anim_scale, "deflection magnification (default: the peak drawn at 10% of the arm)")->check(CLI::PositiveNumber);
+  an->add_option("--view", anim_view, "3d (default), xy, xz or yz")->check(CLI::IsMember({"3d", "xy", "xz", "yz"}));
+  an->add_option("--fps", anim_fps, "frames per second (default 25)")->check(kPositiveInt);
+  an->add_option("--frames", anim_frames, "at most this many frames, the stored steps thinned evenly (default 300)")->check(kPositiveInt);
   auto* rf = app.add_subcommand("refine", "convergence tables of quantities over a series of n");
   add_common(rf, false);
   RefineOptions ro;
@@ -110,7 +126,7 @@ int main(int argc, char** argv) {
     bool known = false;
     for (const auto* sub : app.get_subcommands([](const CLI::App*) { return true; })) known |= sub->get_name() == w;
     if (!known) {
-      fmt::print(stderr, "rfem: error: unknown command '{}' (show, static, modes, run, refine, plot; rfem --help)\n", w);
+      fmt::print(stderr, "rfem: error: unknown command '{}' (show, static, modes, run, refine, plot, view, animate; rfem --help)\n", w);
       return 2;
     }
   }
@@ -139,6 +155,17 @@ int main(int argc, char** argv) {
     if (st->parsed()) return run_static(common, mo);
     if (md->parsed()) return run_modes(common, mo);
     if (pl->parsed()) return run_plot(plot_file, plot_dir, plot_format, paper_signs);
+    if (vw->parsed()) return run_view(view_file, view_runs);
+    if (an->parsed()) {
+      std::vector<std::string> args{anim_file};
+      if (!anim_out.empty()) args.insert(args.end(), {"-o", anim_out});
+      if (!anim_run.empty()) args.insert(args.end(), {"--run", anim_run});
+      if (anim_scale > 0) args.insert(args.end(), {"--scale", fmt::format("{}", anim_scale)});
+      if (!anim_view.empty()) args.insert(args.end(), {"--view", anim_view});
+      if (anim_fps > 0) args.insert(args.end(), {"--fps", std::to_string(anim_fps)});
+      if (anim_frames > 0) args.insert(args.end(), {"--frames", std::to_string(anim_frames)});
+      return run_animate(args);
+    }
     if (rn->parsed()) {
       if (output.empty()) {
         std::string stem = common.case_path.substr(common.case_path.find_last_of('/') + 1);

@@ -40,12 +40,35 @@ Vec3 point_in_link_frame(const Model& model, int l, double s, const VecX& q) {
 }
 
 Vec3 point_position(const Model& model, int l, double s, const VecX& q) {
-  const Vec3 local = point_in_link_frame(model, l, s, q);  // (checks l and q)
+  std::vector<Vec3> pos, deflection;
+  axis_points(model, l, {s}, q, pos, deflection);  // (checks l and q)
+  return pos[0];
+}
+
+void axis_points(const Model& model, int l, const std::vector<double>& s, const VecX& q, std::vector<Vec3>& pos,
+                 std::vector<Vec3>& deflection) {
+  RFEM_CHECK_INDEX(l, model.links.size(), "link");
+  RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
   BaseKinematics bk;
   const VecX z = VecX::Zero(model.dof());
   base_kinematics(model, q, z, z, bk);
   const Mat4& B0 = bk.frame[l].B0;
-  return B0.topLeftCorner<3, 3>() * local + B0.topRightCorner<3, 1>();
+  pos.resize(s.size());
+  deflection.resize(s.size());
+  for (size_t i = 0; i < s.size(); ++i) {
+    const Vec3 local = point_in_link_frame(model, l, s[i], q);
+    pos[i] = B0.topLeftCorner<3, 3>() * local + B0.topRightCorner<3, 1>();
+    deflection[i] = B0.topLeftCorner<3, 3>() * (local - Vec3(s[i], 0.0, 0.0));
+  }
+}
+
+std::vector<double> axis_stations(const Model& model, int l) {
+  RFEM_CHECK_INDEX(l, model.links.size(), "link");
+  const Discretisation& d = model.links[l].d;
+  std::vector<double> s{0.0};
+  for (const auto& r : d.rfes) s.push_back(r.centre[0]);
+  s.push_back(d.length);
+  return s;
 }
 
 Vec3 tip_position(const Model& model, int l, const VecX& q) {

@@ -16,6 +16,12 @@ Vec3 tip_deflection(const Model& model, int l, const VecX& q);
 Vec3 point_in_link_frame(const Model& model, int l, double s, const VecX& q);
 /// The same point in the inertial frame {0}.
 Vec3 point_position(const Model& model, int l, double s, const VecX& q);
+/// Points at s[i] along link l's elastic axis in {0} (pos) and their displacement from the undeformed
+/// axis, in {0} axes (deflection): one kinematics pass for all points.
+void axis_points(const Model& model, int l, const std::vector<double>& s, const VecX& q, std::vector<Vec3>& pos,
+                 std::vector<Vec3>& deflection);
+/// The stations axis_points draws a link at: its start, every rfe's mass centre, its free end.
+std::vector<double> axis_stations(const Model& model, int l);
 /// Position of link l's free end (on the elastic axis) in the inertial frame {0}.
 Vec3 tip_position(const Model& model, int l, const VecX& q);
 /// Origin of every joint's frame (where the body it moves is placed) in {0}.

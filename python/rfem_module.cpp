@@ -14,6 +14,7 @@
 #include <memory>
 
 #include "rfem/cases/case_file.hpp"
+#include "rfem/results/xdmf.hpp"
 #include "rfem/results/errors.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/modes_study.hpp"
@@ -276,6 +277,13 @@ PYBIND11_MODULE(_rfem, m) {
     return py::make_tuple(out, error, warnings);
   }, py::arg("case"), py::arg("n"), py::arg("output"), py::arg("runs"), py::arg("threads"), py::arg("keep_series"),
      py::arg("progress"));
+
+  m.def("write_xdmf", [](const std::string& results, const std::vector<std::string>& runs) {
+    py::gil_scoped_release release;
+    return write_xdmf(results, runs);
+  }, py::arg("results"), py::arg("runs") = std::vector<std::string>{},
+     "ParaView (XDMF 3) files beside a results file for every run (or `runs`) that stored its poses "
+     "(simulation.store_flexible_every > 0); returns the paths written. rfem view RESULTS.h5 does the same.");
 
   m.def("_show", [](const Case& cs, int n) {
     const ModelSummary s = show_model(cs, n);

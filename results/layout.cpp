@@ -67,6 +67,19 @@ RunLayout run_layout(const Model& model, int flexible_every) {
         }
       add(S, g + "payload_position", cols, units, "reference point of each payload (on the elastic axis) in {0}");
     }
+    if (flexible) {  // the pose of the link's elastic axis (rfem view, rfem animate)
+      std::vector<std::string> cols, units;
+      const int P = static_cast<int>(axis_stations(model, static_cast<int>(&L - model.links.data())).size());
+      for (int k = 0; k < P; ++k)
+        for (const char* c : {".x", ".y", ".z"}) {
+          cols.push_back((k == 0 ? std::string("start") : k == P - 1 ? std::string("tip") : "rfe" + std::to_string(k)) + c);
+          units.push_back("m");
+        }
+      add(out.flexible, g + "axis_position", cols, units,
+          "points of the elastic axis in {0}: the link's start, the mass centre station of every rfe, its free end");
+      add(out.flexible, g + "axis_deflection", cols, units,
+          "displacement of the axis_position points from the undeformed axis, in {0} axes");
+    }
     if (L.n() == 0) continue;
     if (flexible) {
       std::vector<std::string> cols, units;
@@ -153,6 +166,15 @@ void flexible_rows(const Model& model, const RunLayout& layout, const OutputSamp
   size_t i = 1;
   for (int l = 0; l < static_cast<int>(model.links.size()); ++l) {
     const MountedLink& L = model.links[l];
+    {
+      std::vector<Vec3> pos, def;
+      axis_points(model, l, axis_stations(model, l), s.q, pos, def);
+      for (const auto* v : {&pos, &def}) {
+        std::vector<double>& row = rows[i++];
+        row.clear();
+        for (const Vec3& p : *v) row.insert(row.end(), {p[0], p[1], p[2]});
+      }
+    }
     if (L.n() == 0) continue;
     std::vector<double>& row = rows[i++];
     row.resize(6 * L.n());

@@ -48,18 +48,56 @@ bool ResultsReader::has(const std::string& object) const {
   return H5Oexists_by_name(impl_->file, object.c_str(), H5P_DEFAULT) > 0;
 }
 
+namespace {
+
+// Opens a 2-D float dataset and reads its dimensions (every failure a ResultsError).
+h5::Handle open_table(hid_t file, const std::string& object, const std::string& what, hsize_t dims[2]) {
+  h5::Handle d = h5::dataset(H5Dopen2(file, object.c_str(), H5P_DEFAULT), what);
+  const h5::Handle s = h5::space(H5Dget_space(d), what);
+  const int rank = H5Sget_simple_extent_ndims(s);
+  if (rank != 2) throw ResultsError(what + ": a table has 2 dimensions, this one " + std::to_string(rank));
+  h5::check(H5Sget_simple_extent_dims(s, dims, nullptr), what);
+  const h5::Handle t = h5::type(H5Dget_type(d), what);
+  if (H5Tget_class(t) != H5T_FLOAT) throw ResultsError(what + ": not a table of numbers");
+  return d;
+}
+
+}  // namespace
+
+std::pair<long, long> ResultsReader::shape(const std::string& object) const {
+  const h5::Quiet quiet;
+  const std::string what = impl_->path + ": " + object;
+  if (!has(object)) throw ResultsError(what + ": no such dataset");
+  hsize_t dims[2] = {0, 0};
+  open_table(impl_->file, object, what, dims);
+  return {static_cast<long>(dims[0]), static_cast<long>(dims[1])};
+}
+
+std::vector<std::string> ResultsReader::children(const std::string& group) const {
+  const h5::Quiet quiet;
+  const std::string what = impl_->path + ": " + group;
+  if (group != "/" && !has(group)) throw ResultsError(what + ": no such group");
+  const h5::Handle g = h5::group(H5Gopen2(impl_->file, group.c_str(), H5P_DEFAULT), what);
+  H5G_info_t info;
+  h5::check(H5Gget_info(g, &info), what);
+  std::vector<std::string> out;
+  for (hsize_t i = 0; i < info.nlinks; ++i) {
+    const ssize_t len = H5Lget_name_by_idx(g, ".", H5_INDEX_NAME, H5_ITER_INC, i, nullptr, 0, H5P_DEFAULT);
+    if (len < 0) throw ResultsError(what + ": cannot list the group");
+    std::string name(static_cast<size_t>(len) + 1, '\0');
+    H5Lget_name_by_idx(g, ".", H5_INDEX_NAME, H5_ITER_INC, i, name.data(), name.size(), H5P_DEFAULT);
+    name.resize(static_cast<size_t>(len));
+    out.push_back(name);
+  }
+  return out;
+}
+
 Table ResultsReader::table(const std::string& object) const {
   const h5::Quiet quiet;
   const std::string what = impl_->path + ": " + object;
   if (!has(object)) throw ResultsError(what + ": no such dataset");
-  const h5::Handle d = h5::dataset(H5Dopen2(impl_->file, object.c_str(), H5P_DEFAULT), what);
-  const h5::Handle s = h5::space(H5Dget_space(d), what);
-  const int rank = H5Sget_simple_extent_ndims(s);
-  if (rank != 2) throw ResultsError(what + ": a table has 2 dimensions, this one " + std::to_string(rank));
   hsize_t dims[2] = {0, 0};
-  h5::check(H5Sget_simple_extent_dims(s, dims, nullptr), what);
-  const h5::Handle t = h5::type(H5Dget_type(d), what);
-  if (H5Tget_class(t) != H5T_FLOAT) throw ResultsError(what + ": not a table of numbers");
+  const h5::Handle d = open_table(impl_->file, object, what, dims);
   Table out;
   out.rows = static_cast<long>(dims[0]);
   out.cols = static_cast<long>(dims[1]);

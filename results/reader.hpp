@@ -4,6 +4,7 @@
 // read past an array).
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rfem/results/errors.hpp"
@@ -34,6 +35,10 @@ class ResultsReader {
   bool has(const std::string& object) const;
   /// The 2-D float64 dataset `object`; throws ResultsError if it is missing or not 2-D.
   Table table(const std::string& object) const;
+  /// Rows and columns of the 2-D dataset `object`, without reading it; throws like table().
+  std::pair<long, long> shape(const std::string& object) const;
+  /// The names of the members of group `group` ("/" for the file), in name order.
+  std::vector<std::string> children(const std::string& group) const;
   /// The string attribute `key` of `object` ("/" for the file); `fallback` if there is none.
   std::string attribute(const std::string& object, const std::string& key, const std::string& fallback = "") const;
 

@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh rfem _rfem
 set -x
-build/apps/rfem run cases/paper_deployment.toml -o paper_deployment.h5
+build/apps/rfem run cases/paper_deployment.toml -o paper_deployment.h5 --set simulation.store_flexible_every=1
 build/apps/rfem plot paper_deployment.h5 -o figures
 build/apps/rfem run cases/two_link_arm.toml -o two_link_arm.h5
 build/apps/rfem plot two_link_arm.h5 -o figures
@@ -20,5 +20,5 @@ build/apps/rfem modes cases/kane_spinup.toml --rate 6 --count 4
 set +x
 echo
 echo "== done: built build/apps/rfem and the Python module (installed under ${RFEM_PREFIX:-/usr/local});"
-echo "   wrote paper_deployment.h5, two_link_arm.h5 and $(ls figures | wc -l) figures in figures/:"
+echo "   wrote paper_deployment.h5 (and its ParaView files paper_deployment.*.xdmf), two_link_arm.h5 and $(ls figures | wc -l) figures in figures/:"
 ls figures | sed 's/^/     /'

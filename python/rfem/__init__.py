@@ -25,11 +25,11 @@ import subprocess as _subprocess
 import sys as _sys
 
 from . import _rfem
-from ._rfem import Case, CaseError, Model, ModesResult, ResultsError, Run, StaticResult, __version__, build
+from ._rfem import Case, CaseError, Model, ModesResult, ResultsError, Run, StaticResult, __version__, build, write_xdmf
 
 __all__ = ["Case", "CaseError", "Model", "ModesResult", "ResultsError", "Run", "RunInterrupted", "Runs",
            "StaticResult", "RefineResult", "Tree", "load", "model", "show", "run", "static", "modes", "refine", "plot",
-           "toml_value", "__version__"]
+           "write_xdmf", "animate", "toml_value", "__version__"]
 
 
 class RunInterrupted(KeyboardInterrupt):
@@ -206,6 +206,30 @@ def _plot_script():
         if _os.path.exists(candidate):
             return candidate
     raise FileNotFoundError("rfem_plot.py not found beside the rfem package (set RFEM_PLOT_SCRIPT)")
+
+
+def animate(results, output=None, run=None, scale=None, view="3d", fps=25, frames=300):
+    """The arm of a run moving (`rfem animate`): MP4 (ffmpeg) or GIF by the output's extension
+    (default RESULT.RUN.mp4, .gif without ffmpeg); scale magnifies the deflections (default: the
+    peak drawn at 10 % of the arm); view 3d, xy, xz or yz. Needs a run that stored its poses
+    (simulation.store_flexible_every > 0). Returns the path written; errors raise RuntimeError with
+    the program's one-line message."""
+    args = [_os.fspath(results), "--view", view, "--fps", str(fps), "--frames", str(frames)]
+    args += (["-o", _os.fspath(output)] if output else []) + (["--run", run] if run else []) + \
+        (["--scale", repr(float(scale))] if scale is not None else [])
+    out = _script("rfem_animate.py", "RFEM_ANIMATE_SCRIPT", args, "rfem animate: error: ")
+    return [l[len("wrote "):].split(" (")[0] for l in out.splitlines() if l.startswith("wrote ")][0]
+
+
+def _script(name, env, args, prefix):
+    path = _os.environ.get(env) or _os.path.join(_os.path.dirname(_os.path.abspath(__file__)), name)
+    if not _os.path.exists(path):
+        raise FileNotFoundError("%s not found beside the rfem package (set %s)" % (name, env))
+    p = _subprocess.run([_sys.executable, path] + args, capture_output=True, text=True)
+    if p.returncode != 0:
+        lines = [l for l in p.stderr.strip().splitlines() if l.startswith(prefix)] or p.stderr.strip().splitlines()
+        raise RuntimeError(lines[-1].replace(prefix, "") if lines else name + " failed")
+    return p.stdout
 
 
 def plot(results, outdir=None, format="png", paper_signs=False):
