@@ -36,7 +36,9 @@ std::string polyline(long points) {
 std::string write_run(const ResultsReader& in, const std::string& run, const fs::path& out) {
   const std::string h5 = fs::path(in.path()).filename().string();
   const Table time = in.table(run + "/flexible_time");
-  const auto [rows_out, m3] = in.has(run + "/joint_position") ? in.shape(run + "/joint_position") : std::pair<long, long>{0, 0};
+  // (plain variables, not structured bindings: clang 14 cannot capture those in the lambdas below)
+  const std::pair<long, long> base_shape = in.has(run + "/joint_position") ? in.shape(run + "/joint_position") : std::pair<long, long>{0, 0};
+  const long rows_out = base_shape.first, m3 = base_shape.second;
   // The output row of each flexible row: the one at the same time (both series are written together).
   const std::vector<double> t_out = in.table(run + "/time").column(0);
   std::vector<long> at(static_cast<size_t>(time.rows), 0);
@@ -84,7 +86,8 @@ std::string write_run(const ResultsReader& in, const std::string& run, const fs:
   for (const Line& L : links) {
     const std::string p = run + "/links/" + L.name + "/payload_position";
     if (!in.has(p)) continue;
-    const auto [r, c] = in.shape(p);
+    const std::pair<long, long> shape = in.shape(p);
+    const long r = shape.first, c = shape.second;
     temporal(L.name + "_payloads", [&](long k) {
       x << "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << c / 3 << "\"/><Geometry GeometryType=\"XYZ\">"
         << row_item(h5, p, r, c / 3, std::min(at[static_cast<size_t>(k)], r - 1)) << "</Geometry>";
