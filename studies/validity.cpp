@@ -4,13 +4,16 @@
 
 #include <cmath>
 
+#include "rfem/core/check.hpp"
+
 namespace rfem {
 
 ValidityMonitor::ValidityMonitor(const Model& model) : model_(model) {
-  for (const MountedLink& L : model.links) links_.push_back({L.name, L.d.length});
+  for (const MountedLink& L : model.links) links_.push_back({L.name});
 }
 
 void ValidityMonitor::check(const VecX& q, double t) {
+  RFEM_CHECK_ARGUMENT_SIZE(q.size(), model_.dof(), "q");
   for (size_t l = 0; l < links_.size(); ++l) {
     Link& s = links_[l];
     const int n = model_.links[l].n();

@@ -22,14 +22,11 @@ class ValidityMonitor {
   void check(const VecX& q, double t);
   /// One warning per link whose rfes turned beyond kSmallRotation ("" context: "the solution").
   std::vector<std::string> warnings(const std::string& context) const;
-  /// The largest rotation of an rfe of link l relative to {r} seen so far [rad].
-  double largest_rotation(int l) const { return links_[l].peak; }
 
  private:
   struct Link {
     std::string name;
-    double length = 0.0;
-    double peak = 0.0, peak_t = 0.0, first_t = -1.0;
+    double peak = 0.0, peak_t = 0.0, first_t = 0.0;
     int peak_rfe = -1;
     bool exceeded = false;
   };
