@@ -5,7 +5,6 @@
 #include "commands.hpp"
 #include "progress.hpp"
 #include "signals.hpp"
-#include "rfem/results/xdmf.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/recorders.hpp"
 
@@ -80,14 +79,7 @@ int run_simulation(const Common& c, const std::string& output) {
   file.close();
   const RunResult& last = runs.back();
   // ParaView's view of every run that stored its poses (also of a failed run: what it computed).
-  std::vector<std::string> xdmf;
-  if (cs.sim.flexible_every > 0 && model->n() > 0) {
-    try {
-      xdmf = write_xdmf(output);
-    } catch (const std::exception& e) {
-      print_warning(std::string("no ParaView file: ") + e.what());
-    }
-  }
+  const std::vector<std::string> xdmf = write_views(cs, *model, output, print_warning);
   if (c.json) {
     nlohmann::json js = nlohmann::json::array();
     for (const auto& r : runs) {

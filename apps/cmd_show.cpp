@@ -18,8 +18,10 @@ int run_show(const Common& c) {
     entries.push_back({{"kind", e.kind}, {"name", e.name}, {"depth", e.depth}, {"parent", e.parent}, {"where", e.where},
                        {"mass", e.mass}, {"length", e.length}, {"rfes", e.rfes}, {"detail", e.detail},
                        {"coordinates", e.coordinates}});
+  nlohmann::json frames = nlohmann::json::array();
+  for (const TreeEntry& f : s.frames) frames.push_back({{"name", f.name}, {"parent", f.parent}, {"where", f.where}});
   print_json({{"command", "show"}, {"case", cs.path}, {"n", s.n}, {"m", s.m}, {"dof", s.dof}, {"unknowns", s.unknowns},
-              {"mass", s.mass}, {"entries", entries}});
+              {"mass", s.mass}, {"entries", entries}, {"urdf", s.urdf}, {"frames", frames}});
   return 0;
 }
 

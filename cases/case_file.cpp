@@ -200,7 +200,7 @@ Case parse_case(const std::string& text, const std::string& path, const std::vec
   std::vector<ParentRef> joint_parents, link_parents;
   read_links(r, root, mats, secs, c, link_parents);
   read_joints(r, root, mats, secs, case_dir, c, joint_parents);
-  if (const toml::node* bn = root.get("base")) read_base(r, bn, mats, secs, path, c, joint_parents);
+  if (const toml::node* bn = root.get("base")) read_base(r, bn, mats, secs, path, case_dir, c, joint_parents);
   resolve_parents(r, c, joint_parents, link_parents);
   if (!c.has_link() && c.joints.empty()) r.fail(&root, "link", "a case needs a flexible link, joints, or both");
 

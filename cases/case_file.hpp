@@ -55,6 +55,14 @@ struct LinkCase {
   Mounting on;       ///< what it sits on (resolved; default: the last joint)
 };
 
+/// A frame fixed to a body, by name: a URDF link, welded to the body of the joint that moves it
+/// (through a chain of fixed joints: X), or to the ground (joint −1).
+struct BodyFrame {
+  std::string name;
+  int joint = -1;
+  Mat4 X = Mat4::Identity();
+};
+
 struct Case {
   std::string path;      ///< the file (or the name given to parse_case): messages start with it
   std::string base_dir;  ///< where relative table and results paths are found ("" or ending in '/')
@@ -73,6 +81,8 @@ struct Case {
   }
   std::vector<Joint> joints;       ///< a free base's six joints first, then [[joints]] (mountings resolved)
   bool free_base = false;          ///< [base] kind = "free"
+  std::string urdf;                ///< [base] urdf: the file the first joints came from ("" if none)
+  std::vector<BodyFrame> frames;   ///< the URDF's links (what a link or joint may be mounted on by name)
   VecX joint_values, joint_rates;  ///< initial/held values and steady rates
   double gravity = 0.0;
   TipLoads loads;                  ///< on the link [loads] names (the last by default)

@@ -225,9 +225,14 @@ struct ParentRef {
 /// [[joints]] into c.joints, c.inputs, c.joint_values/rates; their parents into `parents`.
 void read_joints(const Reader& r, const toml::table& root, const Materials& mats, const Sections& secs,
                  const std::string& case_dir, Case& c, std::vector<ParentRef>& parents);
+/// [base] urdf = "…": the URDF's movable joints ahead of the case's, its links in c.frames.
+void read_urdf_base(const Reader& r, const toml::table& bt, const std::string& case_dir, Case& c,
+                    std::vector<ParentRef>& parents);
+/// A joint's input table (joints.i.input, base.joints.NAME.input).
+InputSpec read_input(const Reader& r, const toml::table& t, const std::string& path, const std::string& case_dir);
 /// [base] kind = "free": six joints ahead of the case's (with parents that need no names).
 void read_base(const Reader& r, const toml::node* bn, const Materials& mats, const Sections& secs,
-               const std::string& path, Case& c, std::vector<ParentRef>& parents);
+               const std::string& path, const std::string& case_dir, Case& c, std::vector<ParentRef>& parents);
 /// [link] (one link) or [[links]] into c.links; their parents into `parents`.
 void read_links(const Reader& r, const toml::table& root, const Materials& mats, const Sections& secs, Case& c,
                 std::vector<ParentRef>& parents);

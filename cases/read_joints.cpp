@@ -124,11 +124,19 @@ void read_joints(const Reader& r, const toml::table& root, const Materials& mats
 
 // at the given pose and rates; the bus body rides on the last.
 void read_base(const Reader& r, const toml::node* bn, const Materials& mats, const Sections& secs,
-               const std::string& path, Case& c, std::vector<ParentRef>& parents) {
-  if (!bn->is_table()) r.fail(bn, "base", "must be a table {kind = \"free\", body = …}");
+               const std::string& path, const std::string& case_dir, Case& c, std::vector<ParentRef>& parents) {
+  if (!bn->is_table()) r.fail(bn, "base", "must be a table {kind = \"free\", body = …} or {urdf = \"arm.urdf\"}");
   const toml::table& bt = *bn->as_table();
+  if (bt.get("urdf")) {
+    r.check_keys(bt, "base", {"kind", "urdf", "joints"});
+    if (r.string(bt, "base", "kind", std::string("fixed")) != "fixed")
+      r.fail(bt.get("kind"), "base.kind", "a URDF base is fixed: its root link is the ground");
+    read_urdf_base(r, bt, case_dir, c, parents);
+    return;
+  }
+  if (bt.get("joints")) r.fail(bt.get("joints"), "base.joints", "applies to a URDF base only ([base] urdf = \"…\")");
   r.check_keys(bt, "base", {"kind", "body", "position", "velocity", "yaw", "pitch", "roll", "yaw_rate", "pitch_rate",
-                            "roll_rate"});
+                            "roll_rate", "urdf"});
   const std::string kind = r.string(bt, "base", "kind", std::string("fixed"));
   if (kind == "fixed") {
     // (the free base's keys stay legal, so `--set base.kind=fixed` compares the two)

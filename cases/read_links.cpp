@@ -128,13 +128,23 @@ void resolve_parents(const Reader& r, Case& c, const std::vector<ParentRef>& joi
       on.kind = Mounting::Kind::Ground;
     } else {
       const auto it = named.find(pr.name);
-      if (it == named.end()) {
+      const auto f = std::find_if(c.frames.begin(), c.frames.end(), [&](const BodyFrame& b) { return b.name == pr.name; });
+      if (f != c.frames.end()) {  // a URDF link: on the body it is welded to, through its frame
+        if (it != named.end() && !(it->second.kind == Mounting::Kind::Joint && it->second.index == f->joint && f->X == Mat4::Identity()))
+          r.fail(pr.node, pr.path + ".parent", "'" + pr.name + "' names a URDF link and a " +
+                                                   (it->second.kind == Mounting::Kind::Joint ? "joint" : "link") + " of another body: rename one");
+        on.kind = f->joint >= 0 ? Mounting::Kind::Joint : Mounting::Kind::Ground;
+        on.index = f->joint;
+        on.X = f->X * pr.X;
+      } else if (it == named.end()) {
         std::string list;
         for (const auto& [k, e] : named) list += (list.empty() ? "" : ", ") + k;
+        for (const BodyFrame& b : c.frames) list += ", " + b.name;
         r.fail(pr.node, pr.path + ".parent", "no joint or link named '" + pr.name + "' (" + list + ", or \"ground\")");
+      } else {
+        on.kind = it->second.kind;
+        on.index = it->second.index;
       }
-      on.kind = it->second.kind;
-      on.index = it->second.index;
     }
     if (pr.at) {
       if (on.kind != Mounting::Kind::Link)

@@ -46,7 +46,7 @@ Vec3 point_position(const Model& model, int l, double s, const VecX& q) {
 }
 
 void axis_points(const Model& model, int l, const std::vector<double>& s, const VecX& q, std::vector<Vec3>& pos,
-                 std::vector<Vec3>& deflection) {
+                 std::vector<Vec3>& deflection, std::vector<Mat3>* rotation) {
   RFEM_CHECK_INDEX(l, model.links.size(), "link");
   RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
   BaseKinematics bk;
@@ -59,6 +59,19 @@ void axis_points(const Model& model, int l, const std::vector<double>& s, const 
     const Vec3 local = point_in_link_frame(model, l, s[i], q);
     pos[i] = B0.topLeftCorner<3, 3>() * local + B0.topRightCorner<3, 1>();
     deflection[i] = B0.topLeftCorner<3, 3>() * (local - Vec3(s[i], 0.0, 0.0));
+  }
+  if (!rotation) return;
+  rotation->resize(s.size());
+  const MountedLink& L = model.links[l];
+  for (size_t i = 0; i < s.size(); ++i) {
+    const int k = rfe_at(L.d, s[i]);
+    if (k < 0) {
+      (*rotation)[i] = B0.topLeftCorner<3, 3>();
+      continue;
+    }
+    DeformationTransform d;
+    deformation_transform(q.segment<6>(model.rfe_index(l, k)), d, false);
+    (*rotation)[i] = B0.topLeftCorner<3, 3>() * d.D.topLeftCorner<3, 3>();
   }
 }
 

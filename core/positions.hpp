@@ -17,9 +17,11 @@ Vec3 point_in_link_frame(const Model& model, int l, double s, const VecX& q);
 /// The same point in the inertial frame {0}.
 Vec3 point_position(const Model& model, int l, double s, const VecX& q);
 /// Points at s[i] along link l's elastic axis in {0} (pos) and their displacement from the undeformed
-/// axis, in {0} axes (deflection): one kinematics pass for all points.
+/// axis, in {0} axes (deflection): one kinematics pass for all points. With `rotation`, also the
+/// orientation of the body each point moves with ({r} on the span of rfe_0 and for a rigid link,
+/// else its rfe's frame): the rotation from that frame to {0}.
 void axis_points(const Model& model, int l, const std::vector<double>& s, const VecX& q, std::vector<Vec3>& pos,
-                 std::vector<Vec3>& deflection);
+                 std::vector<Vec3>& deflection, std::vector<Mat3>* rotation = nullptr);
 /// The stations axis_points draws a link at: its start, every rfe's mass centre, its free end.
 std::vector<double> axis_stations(const Model& model, int l);
 /// Position of link l's free end (on the elastic axis) in the inertial frame {0}.

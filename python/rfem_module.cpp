@@ -268,7 +268,10 @@ PYBIND11_MODULE(_rfem, m) {
         rq.observers.push_back(recorder.get());
       }
       results = run_case(cs, model, inputs, rq);
-      if (file) file->close();
+      if (file) {
+        file->close();
+        write_views(cs, *model, output, rq.warn);
+      }
     }
     py::list out;
     for (auto& r : results) out.append(std::make_shared<RunResult>(std::move(r)));
@@ -282,7 +285,7 @@ PYBIND11_MODULE(_rfem, m) {
     py::gil_scoped_release release;
     return write_xdmf(results, runs);
   }, py::arg("results"), py::arg("runs") = std::vector<std::string>{},
-     "ParaView (XDMF 3) files beside a results file for every run (or `runs`) that stored its poses "
+     "ParaView (XDMF 2) files beside a results file for every run (or `runs`) that stored its poses "
      "(simulation.store_flexible_every > 0); returns the paths written. rfem view RESULTS.h5 does the same.");
 
   m.def("_show", [](const Case& cs, int n) {
@@ -293,7 +296,10 @@ PYBIND11_MODULE(_rfem, m) {
                               py::arg("parent") = e.parent, py::arg("where") = e.where, py::arg("mass") = e.mass,
                               py::arg("length") = e.length, py::arg("rfes") = e.rfes, py::arg("detail") = e.detail,
                               py::arg("coordinates") = e.coordinates));
-    return py::make_tuple(format_summary(s), entries);
+    py::list frames;
+    for (const TreeEntry& f : s.frames)
+      frames.append(py::dict(py::arg("name") = f.name, py::arg("parent") = f.parent, py::arg("where") = f.where));
+    return py::make_tuple(format_summary(s), entries, s.urdf, frames);
   }, py::arg("case"), py::arg("n"));
 
   py::class_<StaticStudy, std::shared_ptr<StaticStudy>>(m, "StaticResult", "A static equilibrium (rfem.static).")

@@ -79,6 +79,15 @@ RunLayout run_layout(const Model& model, int flexible_every) {
           "points of the elastic axis in {0}: the link's start, the mass centre station of every rfe, its free end");
       add(out.flexible, g + "axis_deflection", cols, units,
           "displacement of the axis_position points from the undeformed axis, in {0} axes");
+      std::vector<std::string> rc, ru;
+      for (int k = 0; k < P; ++k)
+        for (const char* c : {".R11", ".R12", ".R13", ".R21", ".R22", ".R23", ".R31", ".R32", ".R33"}) {
+          rc.push_back((k == 0 ? std::string("start") : k == P - 1 ? std::string("tip") : "rfe" + std::to_string(k)) + c);
+          ru.push_back("1");
+        }
+      add(out.flexible, g + "axis_rotation", rc, ru,
+          "orientation of the body each axis_position point moves with: rotation matrix to {0}, row by row "
+          "(its columns are that body's x, y, z axes; {r} at the start, the rfe's frame, the last rfe's at the tip)");
     }
     if (L.n() == 0) continue;
     if (flexible) {
@@ -168,12 +177,17 @@ void flexible_rows(const Model& model, const RunLayout& layout, const OutputSamp
     const MountedLink& L = model.links[l];
     {
       std::vector<Vec3> pos, def;
-      axis_points(model, l, axis_stations(model, l), s.q, pos, def);
+      std::vector<Mat3> rot;
+      axis_points(model, l, axis_stations(model, l), s.q, pos, def, &rot);
       for (const auto* v : {&pos, &def}) {
         std::vector<double>& row = rows[i++];
         row.clear();
         for (const Vec3& p : *v) row.insert(row.end(), {p[0], p[1], p[2]});
       }
+      std::vector<double>& row = rows[i++];
+      row.clear();
+      for (const Mat3& R : rot)
+        for (int a = 0; a < 3; ++a) row.insert(row.end(), {R(a, 0), R(a, 1), R(a, 2)});
     }
     if (L.n() == 0) continue;
     std::vector<double>& row = rows[i++];

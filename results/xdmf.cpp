@@ -14,12 +14,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// One row (`row`) of the table `dataset` [rows × 3·points] as points × 3 values.
-std::string row_item(const std::string& h5, const std::string& dataset, long rows, long points, long row) {
+// One row (`row`) of the table `dataset` [rows × width·points] as points × width values.
+std::string row_item(const std::string& h5, const std::string& dataset, long rows, long points, long row, int width = 3) {
   std::ostringstream o;
-  o << "<DataItem ItemType=\"HyperSlab\" Dimensions=\"" << points << " 3\" Type=\"HyperSlab\" NumberType=\"Float\" Precision=\"8\">"
-    << "<DataItem Dimensions=\"3 2\" NumberType=\"Int\" Format=\"XML\">" << row << " 0 1 1 1 " << 3 * points << "</DataItem>"
-    << "<DataItem Dimensions=\"" << rows << " " << 3 * points << "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">"
+  o << "<DataItem ItemType=\"HyperSlab\" Dimensions=\"" << points << " " << width << "\" Type=\"HyperSlab\" NumberType=\"Float\" Precision=\"8\">"
+    << "<DataItem Dimensions=\"3 2\" NumberType=\"Int\" Format=\"XML\">" << row << " 0 1 1 1 " << width * points << "</DataItem>"
+    << "<DataItem Dimensions=\"" << rows << " " << width * points << "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">"
     << h5 << ":/" << dataset << "</DataItem></DataItem>";
   return o.str();
 }
@@ -47,15 +47,16 @@ std::string write_run(const ResultsReader& in, const std::string& run, const fs:
     at[static_cast<size_t>(k)] = i;
   }
   struct Line {
-    std::string name, position, deflection;
+    std::string name, position, deflection, rotation_name;
     long rows, points;
+    bool rotation;
   };
   std::vector<Line> links;
   for (const std::string& l : in.children(run + "/links")) {
     const std::string g = run + "/links/" + l + "/";
     if (!in.has(g + "axis_position")) continue;
     const auto [r, c] = in.shape(g + "axis_position");
-    links.push_back({l, g + "axis_position", g + "axis_deflection", r, c / 3});
+    links.push_back({l, g + "axis_position", g + "axis_deflection", g + "axis_rotation", r, c / 3, in.has(g + "axis_rotation")});
   }
   if (links.empty())
     throw ResultsError(in.path() + ": " + run + ": no stored poses (run with simulation.store_flexible_every > 0)");
@@ -77,6 +78,9 @@ std::string write_run(const ResultsReader& in, const std::string& run, const fs:
       x << polyline(L.points) << "<Geometry GeometryType=\"XYZ\">" << row_item(h5, L.position, L.rows, L.points, std::min(k, L.rows - 1))
         << "</Geometry><Attribute Name=\"deflection\" AttributeType=\"Vector\" Center=\"Node\">"
         << row_item(h5, L.deflection, L.rows, L.points, std::min(k, L.rows - 1)) << "</Attribute>";
+      if (L.rotation)  // each station's body frame: ParaView's "Tensor Glyph" draws its axes
+        x << "<Attribute Name=\"frame\" AttributeType=\"Tensor\" Center=\"Node\">"
+          << row_item(h5, L.rotation_name, L.rows, L.points, std::min(k, L.rows - 1), 9) << "</Attribute>";
     });
   if (m3 > 0)  // the base: a polyline through the joint origins
     temporal("base", [&](long k) {

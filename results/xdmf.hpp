@@ -2,7 +2,8 @@
 // XDMF (version 2: ParaView's "XDMF Reader"; its Xdmf3 readers do not take hyperslabs) descriptions of a results file for ParaView and VTK: per run, the arm at every
 // step that stores the flexible state (simulation.store_flexible_every): the elastic axis of every
 // link as a polyline through its start, its rfes' mass-centre stations and its free end (with the
-// deflection from the undeformed axis as a point vector: ParaView's "Warp By Vector" magnifies it),
+// deflection from the undeformed axis as a point vector: ParaView's "Warp By Vector" magnifies it;
+// the frame of the body each point moves with as a tensor, its columns the body's axes in {0}),
 // the base as a polyline through the joint origins, payloads as points. The geometry stays in the
 // HDF5 file; the XDMF selects one row of its tables per step (hyperslabs), so nothing is copied.
 #include <string>

@@ -1,5 +1,7 @@
 #include "rfem/studies/recorders.hpp"
 
+#include "rfem/results/xdmf.hpp"
+
 namespace rfem {
 
 void Hdf5Recorder::begin(const RunInfo& info) {
@@ -20,6 +22,16 @@ void Hdf5Recorder::end(const RunResult& r) {
   o.t_reached = r.t_reached;
   o.stats = r.stats;
   run_->finish(o, r.wall_s, r.warnings);
+}
+
+std::vector<std::string> write_views(const Case& cs, const Model& model, const std::string& results, const Warnings& warn) {
+  if (cs.sim.flexible_every <= 0 || model.n() == 0) return {};
+  try {  // (also of a failed run: what it computed)
+    return write_xdmf(results);
+  } catch (const std::exception& e) {
+    if (warn) warn(std::string("no ParaView file: ") + e.what());
+    return {};
+  }
 }
 
 FileDescription describe(const Case& cs, const std::string& command_line, const std::string& procedure, long n,

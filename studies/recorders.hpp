@@ -24,6 +24,11 @@ class Hdf5Recorder : public RunObserver {
   std::unique_ptr<RunWriter> run_;
 };
 
+/// ParaView's view (results/xdmf.hpp) of a results file just written for the case, when its runs
+/// stored their poses (simulation.store_flexible_every > 0 and rfes); returns the files written.
+/// A view that cannot be written is a warning, not an error: the results stand without it.
+std::vector<std::string> write_views(const Case& cs, const Model& model, const std::string& results, const Warnings& warn);
+
 /// The attributes that let a results file describe its study: the case as read and after its
 /// overrides, how the file was made, the procedure ("single", "paper", "refine"), n (−1: several),
 /// the threads.

@@ -125,6 +125,17 @@ ModelSummary show_model(const Case& cs, int n) {
   };
   for (int r : roots) visit(r, 0);
   for (const TreeEntry& e : s.entries) s.mass += e.mass;
+  s.urdf = cs.urdf;
+  for (const BodyFrame& f : cs.frames) {
+    TreeEntry e;
+    e.kind = "frame";
+    e.name = f.name;
+    e.parent = f.joint < 0 ? std::string("ground") : M.joints[f.joint].name;
+    const Vec3 x = f.X.topRightCorner<3, 1>();
+    if (x != Vec3::Zero()) e.where = fmt::format("at ({:g}, {:g}, {:g}) m", x[0], x[1], x[2]);
+    if (f.X.topLeftCorner<3, 3>() != Mat3::Identity()) e.where += std::string(e.where.empty() ? "" : ", ") + "turned";
+    s.frames.push_back(e);
+  }
   return s;
 }
 
@@ -132,6 +143,12 @@ std::string format_summary(const ModelSummary& s) {
   std::string out = fmt::format("{}: {} joint{}, {} rfe{} in all; {} coordinates, {} of them unknown under the inputs; "
                                 "{:.6g} kg in all\n",
                                 s.name, s.m, s.m == 1 ? "" : "s", s.n, s.n == 1 ? "" : "s", s.dof, s.unknowns, s.mass);
+  if (!s.urdf.empty()) {
+    out += "base from " + s.urdf + ", its links on the bodies:";
+    for (const TreeEntry& f : s.frames)
+      out += fmt::format(" {} on {}{}{}", f.name, f.parent, f.where.empty() ? "" : " " + f.where, &f == &s.frames.back() ? "" : ";");
+    out += "\n";
+  }
   for (const TreeEntry& e : s.entries) {
     const std::string on = e.parent == "ground" ? "on the ground" : "on " + e.parent + (e.where.empty() ? "" : ", " + e.where);
     std::string what;

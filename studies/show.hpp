@@ -28,6 +28,8 @@ struct ModelSummary {
   int unknowns = 0;          ///< rfe coordinates + joints under force input (when the case has inputs)
   double mass = 0.0;         ///< of every body [kg]
   std::vector<TreeEntry> entries;  ///< depth first, children after their parent
+  std::string urdf;                ///< the URDF file of the base ("" if none)
+  std::vector<TreeEntry> frames;   ///< its links (kind "frame"): the body each is welded to, and where
 };
 
 /// The tree of the case's model with n rfes in all (0: the case's own discretisation).

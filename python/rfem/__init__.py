@@ -119,7 +119,9 @@ def run(case, n=None, output=None, runs=None, threads=0, keep_series=True, progr
     "force") and returns the Runs.
 
     n:           rfes in all links (None: the case's own)
-    output:      an HDF5 results file written while the runs go (the layout of `rfem run`)
+    output:      an HDF5 results file written while the runs go (the layout of `rfem run`), and
+                 beside it ParaView's view of each run when the case stores poses
+                 (simulation.store_flexible_every > 0), as `rfem run` writes them
     runs:        a subset of the procedure's run names, e.g. ["rigid", "kinematic"]
     threads:     kernel threads (0: each run times one thread against all)
     keep_series: keep every series in memory (Run.table, Run.column); False keeps only summaries
@@ -138,9 +140,13 @@ def run(case, n=None, output=None, runs=None, threads=0, keep_series=True, progr
 class Tree(list):
     """The assembled tree of a case (rfem.show): one dict per joint, link and payload — kind, name,
     depth, parent, where (on a link), mass [kg], length [m], rfes, detail (type, axis, input,
-    segments), coordinates (which entries of q) — depth first; str() is the text of `rfem show`."""
+    segments), coordinates (which entries of q) — depth first; str() is the text of `rfem show`.
+    A URDF base: .urdf (its file) and .frames (one dict per URDF link: name, parent — the joint whose
+    body it is welded to, or "ground" — and where on that body)."""
 
     text = ""
+    urdf = ""
+    frames = ()
 
     def __str__(self):
         return self.text
@@ -149,9 +155,9 @@ class Tree(list):
 def show(case, n=None):
     """What the case builds, to check against its drawing: every joint, link and payload with
     what it is mounted on and where, masses, rfes, coordinates and inputs. print(rfem.show(case))."""
-    text, entries = _rfem._show(case, n or 0)
+    text, entries, urdf, frames = _rfem._show(case, n or 0)
     tree = Tree(entries)
-    tree.text = text
+    tree.text, tree.urdf, tree.frames = text, urdf, frames
     return tree
 
 

@@ -85,7 +85,8 @@ def test_static_modes_refine_equal_program():
     assert abs(ref.table("tip:uz")["order"][-1] - 2.0) < 0.05
 
 
-@pytest.mark.parametrize("bad", ["14_negative_E.toml", "85_unknown_parent.toml", "51_unknown_input_kind.toml"])
+@pytest.mark.parametrize("bad", ["14_negative_E.toml", "85_unknown_parent.toml", "51_unknown_input_kind.toml",
+                                 "105_urdf_not_xml.toml", "110_urdf_bad_inertia.toml"])
 def test_bad_input_same_message(bad):
     path = os.path.join(ROOT, "tests", "bad_cases", bad)
     code, _, err = program("static", path)
@@ -206,3 +207,22 @@ def test_show_and_differences():
     runs = rfem.run(case, n=12, runs=["rigid", "kinematic"], threads=1)
     d = np.abs(runs["kinematic"].column("joint_tau", 2) - runs["rigid"].column("joint_tau", 2)).max()
     assert ref.table("peak:kinematic/tau3-rigid/tau3")["value"][-1] == d
+
+
+def test_urdf_arm_from_python(tmp_path):
+    """A URDF base from the module: the frames it built, and a run whose file, ParaView view
+    included, is the program's."""
+    sets = ["simulation.t_end=0.2", "simulation.store_flexible_every=5"]
+    case = rfem.load(case_path("urdf_arm.toml"), overrides=sets)
+    tree = rfem.show(case)
+    assert tree.urdf.endswith("three_link_arm.urdf")
+    frames = {f["name"]: (f["parent"], f["where"]) for f in tree.frames}
+    assert frames["tool0"] == ("elbow", "at (0.2, 0, 0) m") and frames["base_link"] == ("ground", "")
+    run = rfem.run(case, output=tmp_path / "py.h5", threads=1)
+    assert run[0].completed and (tmp_path / "py.run.xdmf").exists()
+    code, _, err = program("run", case_path("urdf_arm.toml"), "-q", "--threads", "1", "-o", str(tmp_path / "cli.h5"),
+                           *[a for s in sets for a in ("--set", s)])
+    assert code == 0, err
+    a, b = h5py.File(tmp_path / "py.h5"), h5py.File(tmp_path / "cli.h5")
+    for name in ("joint_tau", "tip_deflection", "links/tube/axis_rotation"):
+        assert np.array_equal(a["run/" + name][()], b["run/" + name][()]), name

@@ -1,7 +1,8 @@
 """The ParaView files of `rfem run` / `rfem view` / rfem.write_xdmf, read as an XDMF reader does
 (the times of the temporal grids, each grid's hyperslab row of the HDF5 tables) and compared with
 the series the run wrote: the last axis point is the link's tip, the base polyline the joint
-origins; the axis points are the rfes' stations, moved rigidly with {r} when the link does not bend."""
+origins; the axis points are the rfes' stations, moved rigidly with {r} when the link does not bend;
+the frames are rotations, {r} at the start and turned by the tip's rotation at the tip."""
 import os
 import subprocess
 import xml.etree.ElementTree as ET
@@ -32,7 +33,8 @@ def grids(xdmf):
                     start = [int(v) for v in sel.text.split()]
                     rows, cols = (int(v) for v in data.get("Dimensions").split())
                     assert start[2:4] == [1, 1] and start[4] == 1 and start[5] == cols, "one whole row per step"
-                    items[e.get("Name", kind)] = (data.text.split(":")[1], start[0], cols // 3)
+                    width = int(slab.get("Dimensions").split()[1])  # 3: points, vectors; 9: frames
+                    items[e.get("Name", kind)] = (data.text.split(":")[1], start[0], cols // width)
             steps.append((float(g.find("Time").get("Value")), items))
         out[col.get("Name")] = steps
     return out
@@ -73,6 +75,18 @@ def test_xdmf_points_are_the_runs_positions(tmp_path):
             stations = (u - u[0]) @ e
             assert np.allclose(stations[1:-1], f[f"run/links/{name}/rfe_centre"][:, 0], rtol=0, atol=1e-12)
             assert abs(L - 1.0) < 1e-12  # both links of two_link_arm.toml are 1 m long
+            # each station's frame: a rotation; {r} at the start, whose x axis is the undeformed axis
+            fpath, frow, fpoints = items["frame"]
+            assert fpoints == points
+            R = f[fpath][frow].reshape(points, 3, 3)
+            assert np.allclose(R @ R.transpose(0, 2, 1), np.eye(3), atol=1e-12)
+            assert np.allclose(np.linalg.det(R), 1.0, atol=1e-12)
+            assert np.allclose(R[0][:, 0], e, atol=1e-12)
+            # the tip's frame is turned from {r} by the tip rotation φ the run wrote (rx, ry, rz in
+            # {r}): R_r^T R_tip = I + [φ]x up to terms of order |φ|²
+            phi = g["links"][name]["tip"][k][3:]
+            skew = np.array([[0, -phi[2], phi[1]], [phi[2], 0, -phi[0]], [-phi[1], phi[0], 0]])
+            assert np.allclose(R[0].T @ R[-1], np.eye(3) + skew, atol=2 * np.dot(phi, phi) + 1e-14)
     # the base: a polyline through the joint origins at the same output row
     for t, items in G["base"]:
         path, row, points = items["Geometry"]

@@ -1,0 +1,98 @@
+// URDF bases (cases/read_urdf.cpp): the arm of cases/urdf/three_link_arm.urdf with its flexible
+// tube (cases/urdf_arm.toml) against its twin written in TOML joints
+// (tests/urdf/three_link_arm_twin.toml, whose header derives the welded forearm's inertia by the
+// parallel-axis rule): the same torques, deflections, statics and frequencies to round-off. And the
+// gravity torques the held arm needs, from its mass distribution alone.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "rfem/studies/modes_study.hpp"
+#include "rfem/studies/runs.hpp"
+#include "rfem/studies/static_study.hpp"
+#include "tests/test_models.hpp"
+
+using namespace rfem;
+
+namespace {
+const std::vector<std::string> kShort = {"simulation.t_end=1.0"};
+Case urdf_arm() { return read_case(test::source_path("cases/urdf_arm.toml"), kShort); }
+Case twin() { return read_case(test::source_path("tests/urdf/three_link_arm_twin.toml"), kShort); }
+
+// Round-off: both models compose the same transforms in a different order (the URDF's quaternion
+// rotations, the TOML's rpy; the tool's inertia welded by a transform against its decimal form), so
+// results agree to a few ulps of their scale, amplified by the integrator's Newton tolerance no
+// more than the same steps allow: 1e-10 of each series' scale.
+void expect_close(const Table& a, const Table& b, const std::string& what) {
+  ASSERT_EQ(a.rows, b.rows) << what;
+  ASSERT_EQ(a.cols, b.cols) << what;
+  double scale = 0.0, diff = 0.0;
+  for (size_t i = 0; i < a.data.size(); ++i) {
+    scale = std::max(scale, std::abs(a.data[i]));
+    diff = std::max(diff, std::abs(a.data[i] - b.data[i]));
+  }
+  EXPECT_LE(diff, 1e-10 * scale) << what << ": scale " << scale;
+  EXPECT_GT(scale, 0.0) << what;
+}
+}  // namespace
+
+TEST(Urdf, BuildsTheJointsFramesAndBodiesOfItsTwin) {
+  const Case u = urdf_arm(), t = twin();
+  ASSERT_EQ(u.joints.size(), 3u);
+  EXPECT_EQ(u.joints[0].name, "waist");
+  EXPECT_EQ(u.joints[2].name, "elbow");
+  EXPECT_NE(u.urdf.find("three_link_arm.urdf"), std::string::npos);
+  for (size_t j = 0; j < 3; ++j) {
+    EXPECT_LE((u.joints[j].H - t.joints[j].H).cwiseAbs().maxCoeff(), 1e-15) << j;
+    EXPECT_LE((u.joints[j].on.X - t.joints[j].on.X).cwiseAbs().maxCoeff(), 1e-15) << j;
+    EXPECT_EQ(u.joints[j].axis, t.joints[j].axis) << j;
+    EXPECT_EQ(u.joints[j].drive.damping, t.joints[j].drive.damping) << j;
+    EXPECT_EQ(u.joints[j].drive.friction, t.joints[j].drive.friction) << j;
+  }
+  // The tube on the URDF's tool0 sits on the elbow's body 0.2 m out, as in the twin.
+  EXPECT_EQ(u.links[0].on.kind, Mounting::Kind::Joint);
+  EXPECT_EQ(u.links[0].on.index, 2);
+  EXPECT_LE((u.links[0].on.X - t.links[0].on.X).cwiseAbs().maxCoeff(), 1e-15);
+  // Every URDF link is a frame; the root is the ground.
+  ASSERT_EQ(u.frames.size(), 5u);  // base_link, turret, upper_arm, forearm, tool0
+  for (const BodyFrame& f : u.frames)
+    if (f.name == "base_link") EXPECT_EQ(f.joint, -1);
+}
+
+TEST(Urdf, RunsLikeItsTwin) {
+  RunRequest rq;
+  rq.threads = 1;
+  const std::vector<RunResult> a = run_case(urdf_arm(), rq), b = run_case(twin(), rq);
+  ASSERT_TRUE(a[0].completed()) << a[0].status;
+  ASSERT_TRUE(b[0].completed()) << b[0].status;
+  for (const std::string name : {"joint_tau", "tip_deflection", "links/tube/tip"})
+    expect_close(a[0].series->table(name), b[0].series->table(name), name);
+}
+
+TEST(Urdf, StaticsAndFrequenciesLikeItsTwin) {
+  const StaticStudy a = static_study(urdf_arm()), b = static_study(twin());
+  EXPECT_LE((a.tips[0].motion - b.tips[0].motion).cwiseAbs().maxCoeff(), 1e-12 * a.tips[0].motion.cwiseAbs().maxCoeff());
+  ModesRequest rq;
+  rq.count = 6;
+  const ModesStudy ma = modes_study(urdf_arm(), rq), mb = modes_study(twin(), rq);
+  ASSERT_EQ(ma.modes.omega.size(), 6);
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(ma.modes.omega[k], mb.modes.omega[k], 1e-10 * mb.modes.omega[k]) << k;
+}
+
+TEST(Urdf, HeldArmNeedsTheTorquesOfItsWeight) {
+  // At t = 0 the arm is at rest (the deployment law starts with zero rate and acceleration) in
+  // static equilibrium: the shoulder and elbow hold the moments of every mass beyond them about
+  // their horizontal axes, g Σ m x, and the waist holds nothing. The tube's sag (1.6 mm) shortens
+  // its lever by u²/L ~ 1e-6 relative: the bound.
+  RunRequest rq;
+  rq.threads = 1;
+  const std::vector<RunResult> r = run_case(urdf_arm(), rq);
+  const Table tau = r[0].series->table("joint_tau");
+  const double g = 9.81, tube = 2700.0 * (0.03 * 0.03 - 0.027 * 0.027) * 1.2;
+  const double shoulder = g * (3.0 * 0.25 + 2.0 * 0.625 + tube * 1.3 + 0.2 * 1.9);
+  const double elbow = g * (2.0 * 0.125 + tube * 0.8 + 0.2 * 1.4);
+  EXPECT_NEAR(tau.at(0, 0), 0.0, 1e-9);
+  // Positive rotation about y lowers the arm: holding it against gravity takes a negative torque.
+  EXPECT_NEAR(-tau.at(0, 1), shoulder, 1e-5 * shoulder);
+  EXPECT_NEAR(-tau.at(0, 2), elbow, 1e-5 * elbow);
+}
