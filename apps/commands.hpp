@@ -11,6 +11,7 @@
 #include "rfem/results/writer.hpp"
 #include "rfem/solvers/inputs.hpp"
 #include "rfem/studies/common.hpp"
+#include "rfem/studies/sweep.hpp"
 
 namespace rfem::app {
 
@@ -49,6 +50,18 @@ int run_modes(const Common& c, const ModesOptions& o);
 /// `rfem run`: time integration of the case's [simulation], results to an HDF5 file.
 int run_simulation(const Common& c, const std::string& output);
 int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o);
+struct SweepOptions {
+  std::string path;           ///< the sweep file
+  std::string output;         ///< the index (default: [sweep] output, or the sweep's stem + .h5)
+  int jobs = 0;               ///< runs at once on this machine (0: the cores)
+  bool retry_failed = false;  ///< run failed points again
+};
+/// `rfem sweep SWEEP.toml`: here with --jobs, or across MPI ranks when started by mpirun.
+int run_sweep_command(const SweepOptions& o, bool json, bool quiet);
+int run_sweep_mpi(const SweepOptions& o, bool json, bool quiet);
+/// The sweep's progress line (stderr, on a terminal) and its table or JSON; the exit code.
+void print_sweep_progress(const SweepProgress& p);
+int print_sweep(const Sweep& s, const std::vector<SweepRow>& rows, const StopToken& stop, bool json, bool quiet);
 /// `rfem plot RESULTS.h5 [-o DIR]`: PNG figures of a results or refinement file.
 int run_plot(const std::string& results, const std::string& outdir, const std::string& format = "", bool paper_signs = false);
 

@@ -119,6 +119,15 @@ int main(int argc, char** argv) {
   rf->add_flag("--no-integration-check", no_check,
                "do not rerun the finest n at 100x tighter tolerances to estimate the integration error");
   add_rate(rf);
+  auto* sw = app.add_subcommand("sweep", "a parameter sweep: one run per point, quantities per run, one index (--jobs, or under mpirun)");
+  SweepOptions so;
+  bool sweep_json = false, sweep_quiet = false;
+  sw->add_option("sweep", so.path, "sweep file (TOML): [sweep] case, quantities; [parameters] key = [values]")->required();
+  sw->add_option("-o,--output", so.output, "index file (default: [sweep] output, or the sweep file's name with .h5, here)");
+  sw->add_option("--jobs", so.jobs, "runs at once on this machine, one thread each (default: the cores)")->check(kPositiveInt);
+  sw->add_flag("--retry-failed", so.retry_failed, "run the points that failed before again (default: keep their reason)");
+  sw->add_flag("--json", sweep_json, "the table as JSON on stdout");
+  sw->add_flag("-q,--quiet", sweep_quiet, "no progress line and no table");
 
   // A first word that is neither an option nor a command (CLI11 would only say one is required).
   if (argc > 1 && argv[1][0] != '-') {
@@ -126,7 +135,7 @@ int main(int argc, char** argv) {
     bool known = false;
     for (const auto* sub : app.get_subcommands([](const CLI::App*) { return true; })) known |= sub->get_name() == w;
     if (!known) {
-      fmt::print(stderr, "rfem: error: unknown command '{}' (show, static, modes, run, refine, plot, view, animate; rfem --help)\n", w);
+      fmt::print(stderr, "rfem: error: unknown command '{}' (show, static, modes, run, refine, sweep, plot, view, animate; rfem --help)\n", w);
       return 2;
     }
   }
@@ -173,6 +182,7 @@ int main(int argc, char** argv) {
       }
       return run_simulation(common, output);
     }
+    if (sw->parsed()) return run_sweep_command(so, sweep_json, sweep_quiet);
     if (rf->parsed()) {
       ro.integration_check = !no_check;
       return run_refine(common, ro, mo);

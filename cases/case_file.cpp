@@ -161,14 +161,7 @@ Case parse_case(const std::string& text, const std::string& path, const std::vec
   c.path = path;
   c.base_dir = base_dir.empty() || base_dir.back() == '/' ? base_dir : base_dir + "/";
   c.text = text;
-  toml::table root;
-  try {
-    root = toml::parse(c.text, path);
-  } catch (const toml::parse_error& e) {
-    std::ostringstream os;
-    os << path << ":" << e.source().begin.line << ": syntax error: " << e.description();
-    throw CaseError(os.str());
-  }
+  toml::table root = parse_toml(c.text, path);
   for (const auto& o : overrides) apply_override(root, path, o);
   c.overrides = overrides;
   {

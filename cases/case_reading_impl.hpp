@@ -16,6 +16,17 @@ namespace rfem::reading {
 
 constexpr long kMaxRfes = 10000000;  // far beyond memory; guards int overflow of n and parts
 
+/// TOML text parsed, or CaseError "path:line: syntax error: …".
+inline toml::table parse_toml(const std::string& text, const std::string& path) {
+  try {
+    return toml::parse(text, path);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream os;
+    os << path << ":" << e.source().begin.line << ": syntax error: " << e.description();
+    throw CaseError(os.str());
+  }
+}
+
 // Reads typed values from a toml table with the file, line and dotted key in every error.
 class Reader {
  public:

@@ -149,6 +149,12 @@ void read_urdf_base(const Reader& r, const toml::table& bt, const std::string& c
       if (!(j.axis.norm() > 0.0) || !j.axis.allFinite()) fail("joint '" + uj->name + "': axis must be a non-zero direction");
       j.axis.normalize();
       j.H = inertial(child);
+      if (uj->limits) {  // (urdfdom gives 0 for what a <limit> leaves out: not a limit)
+        const urdf::JointLimits& l = *uj->limits;
+        if (uj->type != urdf::Joint::CONTINUOUS && l.lower < l.upper) j.limits.lower = l.lower, j.limits.upper = l.upper;
+        if (l.effort > 0) j.limits.effort = l.effort;
+        if (l.velocity > 0) j.limits.velocity = l.velocity;
+      }
       if (uj->dynamics) {
         j.drive.damping = uj->dynamics->damping;
         j.drive.friction = uj->dynamics->friction;

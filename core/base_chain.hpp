@@ -4,6 +4,7 @@
 // or d_i = q_i + d_i0 (prismatic), and the rigid inertia of every base link. A joint may move
 // about (along) another unit axis u of its DH frame instead of z:
 // A_i = RotX(α) TransX(a) RotZ(θ_i0) TransZ(d_i0) · Rot(u, q_i) (or Trans(u q_i)).
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,15 @@
 namespace rfem {
 
 enum class JointType { Revolute, Prismatic };
+
+/// What a joint is rated for (a URDF's <limit>): rfem does not enforce them — a run warns where
+/// its solution leaves them (studies/validity.hpp). Infinite: none.
+struct JointLimits {
+  double lower = -std::numeric_limits<double>::infinity();  ///< [rad or m]
+  double upper = std::numeric_limits<double>::infinity();
+  double effort = std::numeric_limits<double>::infinity();    ///< |τ| [N m or N]
+  double velocity = std::numeric_limits<double>::infinity();  ///< |q̇| [rad/s or m/s]
+};
 
 struct Joint {
   std::string name;
@@ -26,6 +36,7 @@ struct Joint {
   Mat4 H = Mat4::Zero();  ///< pseudo-inertia of the body it moves (its link, a payload), in its own frame
   JointDrive drive;       ///< rotor/gear inertia, damping, friction of the joint (none by default)
   Mounting on;            ///< what it sits on (default: the previous joint, a serial chain)
+  JointLimits limits;     ///< rated range, speed and effort (warned about, not enforced)
   double mass() const { return H(3, 3); }
 };
 

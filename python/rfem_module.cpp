@@ -127,6 +127,8 @@ JointRate joint_rate(std::optional<double> rate, int joint) {
 
 }  // namespace
 
+void bind_sweep(py::module_& m);  // (sweep_bindings.cpp)
+
 PYBIND11_MODULE(_rfem, m) {
   m.doc() = "rfem's compiled core; use the package `rfem` (help(rfem)).";
   m.attr("__version__") = version_string;
@@ -430,4 +432,5 @@ PYBIND11_MODULE(_rfem, m) {
     return py::make_tuple(out, error);
   }, py::arg("case"), py::arg("ns"), py::arg("quantities"), py::arg("output"), py::arg("integration_check"),
      py::arg("rate"), py::arg("joint"), py::arg("threads"), py::arg("progress"));
+  bind_sweep(m);
 }

@@ -261,6 +261,16 @@ void ResultsWriter::write_attribute(const std::string& object, const std::string
   h5::write_attribute(obj, key, values);
 }
 
+void ResultsWriter::write_external_link(const std::string& name, const std::string& file, const std::string& object) {
+  const h5::Quiet quiet;
+  File& f = *file_;
+  f.end_swmr();
+  const std::string what = f.what("linking " + name);
+  const h5::Handle lcpl = h5::plist(H5Pcreate(H5P_LINK_CREATE), what);
+  h5::check(H5Pset_create_intermediate_group(lcpl, 1), what);
+  h5::check(H5Lcreate_external(file.c_str(), object.c_str(), f.id, name.c_str(), lcpl, H5P_DEFAULT), what);
+}
+
 // ---------------------------------------------------------------------------------------------
 
 struct RunWriter::Impl {

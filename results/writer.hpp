@@ -67,6 +67,9 @@ class ResultsWriter {
   /// String attributes of an object ("/", "modes").
   void write_attribute(const std::string& object, const std::string& key, const std::string& value);
   void write_attribute(const std::string& object, const std::string& key, const std::vector<std::string>& values);
+  /// A link `name` to `object` in another HDF5 file (`file` relative to this one's directory or
+  /// absolute): h5py follows it as a group of this file.
+  void write_external_link(const std::string& name, const std::string& file, const std::string& object);
   /// Flushes and closes the file; throws ResultsError if HDF5 cannot.
   void close();
 

@@ -11,7 +11,7 @@ pkgs=(build-essential cmake ninja-build pkg-config dpkg-dev ca-certificates
       libeigen3-dev libsuitesparse-dev libhdf5-dev hdf5-tools libtomlplusplus-dev libcli11-dev
       libfmt-dev libspdlog-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev
       python3 python3-dev python3-numpy python3-h5py python3-matplotlib python3-pytest pybind11-dev
-      liburdfdom-dev clang libclang-rt-14-dev libomp-14-dev)
+      liburdfdom-dev libopenmpi-dev openmpi-bin clang libclang-rt-14-dev libomp-14-dev)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -3,7 +3,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
-cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRFEM_SANITIZE=ON -DRFEM_BUILD_BENCH=OFF -DRFEM_BUILD_PYTHON=OFF >/dev/null
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRFEM_SANITIZE=ON -DRFEM_BUILD_BENCH=OFF -DRFEM_BUILD_PYTHON=OFF -DRFEM_MPI=OFF >/dev/null
 cmake --build build-asan -j "$(nproc)"
 # detect_leaks: LeakSanitizer on; halt_on_error: the first finding fails the test.
 export ASAN_OPTIONS=detect_leaks=1:halt_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1

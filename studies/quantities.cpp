@@ -294,4 +294,40 @@ std::vector<std::string> runs_read(const std::vector<Quantity>& qs) {
   return runs;
 }
 
+QuantityRecorder::QuantityRecorder(const std::vector<Quantity>& qs, std::string prefix) : qs_(qs), prefix_(std::move(prefix)) {
+  for (const Quantity& q : qs_)
+    for (const QuantityTerm& t : q.terms)
+      if (std::find(terms_.begin(), terms_.end(), t) == terms_.end()) terms_.push_back(t);
+  series_.resize(terms_.size());
+}
+
+void QuantityRecorder::begin(const RunInfo& info) {
+  model_ = info.model;
+  run_ = info.name.substr(std::min(prefix_.size(), info.name.size()));
+}
+
+void QuantityRecorder::sample(const OutputSample& s) {
+  bool any = false;
+  for (size_t i = 0; i < terms_.size(); ++i)
+    if (terms_[i].run == run_) {
+      series_[i].push_back(term_value(*model_, terms_[i], s));
+      any = true;
+    }
+  if (any) times_[run_].push_back(s.t);
+}
+
+std::vector<double> QuantityRecorder::values() const {
+  std::vector<double> out(qs_.size(), NAN);
+  for (size_t k = 0; k < qs_.size(); ++k) {
+    const Quantity& q = qs_[k];
+    if (!q.dynamic()) continue;
+    std::vector<std::vector<double>> s;
+    for (const QuantityTerm& t : q.terms) s.push_back(series_[std::find(terms_.begin(), terms_.end(), t) - terms_.begin()]);
+    const auto times = times_.find(q.terms[0].run);
+    if (times == times_.end()) continue;
+    out[k] = dynamic_value(q, times->second, s);
+  }
+  return out;
+}
+
 }  // namespace rfem

@@ -10,11 +10,14 @@
 //   (torque, coordinate, rate, acceleration of joint J from 1); RUN defaults to the procedure's
 //   main run (kinematic for the paper's, run for a single one). Fig. 6's point, the torque the
 //   flexibility adds, is peak:kinematic/tau3-rigid/tau3.
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "rfem/solvers/equations.hpp"
 #include "rfem/studies/common.hpp"
+#include "rfem/studies/runs.hpp"
 
 namespace rfem {
 
@@ -65,5 +68,24 @@ double term_value(const Model& model, const QuantityTerm& term, const OutputSamp
 double dynamic_value(const Quantity& q, const std::vector<double>& times, const std::vector<std::vector<double>>& series);
 /// The runs the quantities read (what a study must run).
 std::vector<std::string> runs_read(const std::vector<Quantity>& qs);
+
+/// Records, per run it observes (named `prefix` + run), the output times and every series the
+/// dynamic quantities read; values() gives them (NaN for a quantity that is not dynamic or whose
+/// run was not observed).
+class QuantityRecorder : public RunObserver {
+ public:
+  QuantityRecorder(const std::vector<Quantity>& qs, std::string prefix = "");
+  void begin(const RunInfo& info) override;
+  void sample(const OutputSample& s) override;
+  std::vector<double> values() const;
+
+ private:
+  std::vector<Quantity> qs_;
+  std::string prefix_, run_;
+  std::shared_ptr<const Model> model_;
+  std::vector<QuantityTerm> terms_;
+  std::vector<std::vector<double>> series_;
+  std::map<std::string, std::vector<double>> times_;
+};
 
 }  // namespace rfem

@@ -12,57 +12,10 @@ namespace rfem {
 
 namespace {
 
-// Records, per run it observes, the output times and every series the quantities read.
-class QuantityObserver : public RunObserver {
- public:
-  QuantityObserver(const std::vector<Quantity>& qs, std::string prefix) : qs_(qs), prefix_(std::move(prefix)) {
-    for (const Quantity& q : qs)
-      for (const QuantityTerm& t : q.terms)
-        if (std::find(terms_.begin(), terms_.end(), t) == terms_.end()) terms_.push_back(t);
-    series_.resize(terms_.size());
-  }
-  void begin(const RunInfo& info) override {
-    model_ = info.model;
-    run_ = info.name.substr(prefix_.size());
-  }
-  void sample(const OutputSample& s) override {
-    bool any = false;
-    for (size_t i = 0; i < terms_.size(); ++i)
-      if (terms_[i].run == run_) {
-        series_[i].push_back(term_value(*model_, terms_[i], s));
-        any = true;
-      }
-    if (any) times_[run_].push_back(s.t);
-  }
-  /// Every quantity from what was recorded.
-  std::vector<double> values() const {
-    std::vector<double> out(qs_.size(), NAN);
-    for (size_t k = 0; k < qs_.size(); ++k) {
-      const Quantity& q = qs_[k];
-      if (!q.dynamic()) continue;
-      std::vector<std::vector<double>> s;
-      for (const QuantityTerm& t : q.terms)
-        s.push_back(series_[std::find(terms_.begin(), terms_.end(), t) - terms_.begin()]);
-      const auto times = times_.find(q.terms[0].run);
-      if (times == times_.end()) continue;
-      out[k] = dynamic_value(q, times->second, s);
-    }
-    return out;
-  }
-
- private:
-  const std::vector<Quantity>& qs_;
-  std::string prefix_, run_;
-  std::shared_ptr<const Model> model_;
-  std::vector<QuantityTerm> terms_;
-  std::vector<std::vector<double>> series_;
-  std::map<std::string, std::vector<double>> times_;
-};
-
 // One run of the procedure at n — only the runs the quantities read — for every dynamic quantity.
 std::vector<double> evaluate_dynamic(const Case& cs, const std::vector<JointInput>& inputs, int n,
                                      const std::vector<Quantity>& qs, const std::string& prefix, const RefineRequest& rq) {
-  QuantityObserver values(qs, prefix);
+  QuantityRecorder values(qs, prefix);
   RunRequest r;
   r.n = n;
   r.threads = rq.threads;

@@ -84,6 +84,7 @@ RunResult run_one(const std::string& name, std::shared_ptr<const Model> model, c
       pk.theta = std::max(pk.theta, std::abs(u[2]));
     }
     validity.check(x.q, x.t);
+    validity.check_joints(x.q, x.v, x.tau, x.t);
     const double bal = x.energy_balance();
     if (std::isnan(balance0)) balance0 = bal;
     s.energy_drift = std::max(s.energy_drift, std::abs(bal - balance0));

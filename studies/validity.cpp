@@ -10,6 +10,27 @@ namespace rfem {
 
 ValidityMonitor::ValidityMonitor(const Model& model) : model_(model) {
   for (const MountedLink& L : model.links) links_.push_back({L.name});
+  range_.resize(model.joints.size());
+  speed_.resize(model.joints.size());
+  effort_.resize(model.joints.size());
+}
+
+void ValidityMonitor::check_joints(const VecX& q, const VecX& v, const VecX& tau, double t) {
+  RFEM_CHECK_ARGUMENT_SIZE(q.size(), model_.dof(), "q");
+  RFEM_CHECK_ARGUMENT_SIZE(v.size(), model_.dof(), "v");
+  RFEM_CHECK_ARGUMENT_SIZE(tau.size(), model_.m(), "tau");
+  auto note = [t](Excess& e, double by) {  // by > 0: beyond the limit by that much
+    if (!(by > 0.0)) return;
+    if (std::isnan(e.first_t)) e.first_t = t;
+    if (by > e.peak) e.peak = by, e.peak_t = t;
+  };
+  for (int j = 0; j < model_.m(); ++j) {
+    const JointLimits& l = model_.joints[static_cast<size_t>(j)].limits;
+    const double x = q[model_.joint_index(j)], xd = v[model_.joint_index(j)];
+    note(range_[static_cast<size_t>(j)], std::max(l.lower - x, x - l.upper));
+    note(speed_[static_cast<size_t>(j)], std::abs(xd) - l.velocity);
+    note(effort_[static_cast<size_t>(j)], std::abs(tau[j]) - l.effort);
+  }
 }
 
 void ValidityMonitor::check(const VecX& q, double t) {
@@ -44,6 +65,22 @@ std::vector<std::string> ValidityMonitor::warnings(const std::string& context) c
                               "the results are approximate",
                               context.empty() ? "" : context + ": ", s.name, s.peak_rfe + 1, s.peak, when, kSmallRotation, first,
                               100 * err));
+  }
+  for (int j = 0; j < model_.m(); ++j) {
+    const Joint& J = model_.joints[static_cast<size_t>(j)];
+    const bool rev = J.type == JointType::Revolute;
+    const char* u = rev ? "rad" : "m";
+    auto say = [&](const Excess& e, const std::string& what, const std::string& unit) {
+      if (std::isnan(e.first_t)) return;
+      out.push_back(fmt::format("{}joint '{}': {} by up to {:.3g} {} (at t = {:g} s, first at t = {:g} s); rfem does not enforce "
+                                "joint limits",
+                                context.empty() ? "" : context + ": ", J.name, what, e.peak, unit, e.peak_t, e.first_t));
+    };
+    const JointLimits& l = J.limits;
+    say(range_[static_cast<size_t>(j)], fmt::format("its coordinate left its rated range {:g} to {:g} {}", l.lower, l.upper, u), u);
+    say(speed_[static_cast<size_t>(j)], fmt::format("its rate exceeded its rated {:g} {}/s", l.velocity, u), std::string(u) + "/s");
+    say(effort_[static_cast<size_t>(j)], fmt::format("its {} exceeded its rated {:g} {}", rev ? "torque" : "force", l.effort, rev ? "N m" : "N"),
+        rev ? "N m" : "N");
   }
   return out;
 }

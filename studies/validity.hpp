@@ -5,6 +5,7 @@
 // relative size φ²/2 (cos φ ≈ 1 − φ²/2, and the axial/shear split of Δx turns by φ). At 0.1 rad that
 // is 0.5 %, at 0.3 rad 4.5 %: beyond kSmallRotation the results are approximate, and a warning says
 // where and when the solution left the range first, and how far it went.
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -20,7 +21,10 @@ class ValidityMonitor {
   explicit ValidityMonitor(const Model& model);
   /// Looks at a state (full coordinates) at time t (NaN for a static state).
   void check(const VecX& q, double t);
-  /// One warning per link whose rfes turned beyond kSmallRotation ("" context: "the solution").
+  /// Looks at the joints of an output sample against their rated limits (Joint::limits).
+  void check_joints(const VecX& q, const VecX& v, const VecX& tau, double t);
+  /// One warning per link whose rfes turned beyond kSmallRotation ("" context: "the solution"),
+  /// and per joint and limit its solution exceeded.
   std::vector<std::string> warnings(const std::string& context) const;
 
  private:
@@ -30,8 +34,12 @@ class ValidityMonitor {
     int peak_rfe = -1;
     bool exceeded = false;
   };
+  struct Excess {  // of one joint's limit: the largest, when, and when first
+    double peak = 0.0, peak_t = 0.0, first_t = NAN;
+  };
   const Model& model_;
   std::vector<Link> links_;
+  std::vector<Excess> range_, speed_, effort_;  // per joint
 };
 
 }  // namespace rfem

@@ -6,6 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "rfem/studies/modes_study.hpp"
 #include "rfem/studies/runs.hpp"
@@ -95,4 +98,33 @@ TEST(Urdf, HeldArmNeedsTheTorquesOfItsWeight) {
   // Positive rotation about y lowers the arm: holding it against gravity takes a negative torque.
   EXPECT_NEAR(-tau.at(0, 1), shoulder, 1e-5 * shoulder);
   EXPECT_NEAR(-tau.at(0, 2), elbow, 1e-5 * elbow);
+}
+
+TEST(Urdf, RunsWarnWhereTheJointsLeaveTheirRatedLimits) {
+  // The shoulder holds ~30 N m (the test above) and turns at up to π/6 · 2/2 ≈ 0.52 rad/s: rated
+  // 300 N m and 2 rad/s in the URDF it draws no warning; rated 5 N m and 0.3 rad/s it draws two.
+  std::ifstream in(test::source_path("cases/urdf/three_link_arm.urdf"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string urdf = text.str();
+  const std::string rated = R"(effort="300" velocity="2.0")";
+  ASSERT_NE(urdf.find(rated), std::string::npos);
+  urdf.replace(urdf.find(rated), rated.size(), R"(effort="5" velocity="0.3")");
+  const std::string path = (std::filesystem::temp_directory_path() / "rfem_test_weak_arm.urdf").string();
+  std::ofstream(path) << urdf;
+  RunRequest rq;
+  rq.threads = 1;
+  auto joint_warnings = [](const RunResult& r) {
+    std::vector<std::string> w;
+    for (const std::string& x : r.warnings)
+      if (x.find("joint '") != std::string::npos) w.push_back(x);
+    return w;
+  };
+  EXPECT_TRUE(joint_warnings(run_case(urdf_arm(), rq)[0]).empty());
+  const Case weak = with_overrides(urdf_arm(), {"base.urdf=\"" + path + "\""});
+  const std::vector<std::string> w = joint_warnings(run_case(weak, rq)[0]);
+  ASSERT_EQ(w.size(), 2u);
+  EXPECT_NE(w[0].find("joint 'shoulder': its rate exceeded its rated 0.3 rad/s by up to 0.2"), std::string::npos) << w[0];
+  EXPECT_NE(w[1].find("joint 'shoulder': its torque exceeded its rated 5 N m by up to 2"), std::string::npos) << w[1];
+  std::filesystem::remove(path);
 }

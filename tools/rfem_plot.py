@@ -16,6 +16,7 @@ Needs Debian's python3-matplotlib, python3-h5py and python3-numpy (run with /usr
 """
 import argparse
 import os
+import re
 import sys
 import textwrap
 
@@ -339,6 +340,49 @@ def plot_refine(group, outdir, case_name="", joint_units=()):
         save(fig, outdir, "refine_convergence.png" if sub in (None, "q0") else "refine_convergence_%s.png" % sub)
 
 
+def plot_sweep(f, outdir):
+    """A sweep's index: each quantity against each numeric parameter, one line per combination of
+    the others; over n, also the changes between successive n on log scales with their observed
+    orders (the slope: 2 for rfem's converged series)."""
+    names, quantities = list_attr(f["parameters"], "columns"), list_attr(f["quantities"], "columns")
+    values, table = f["parameters"][()], f["quantities"][()]
+    stem = os.path.splitext(os.path.basename(text_attr(f, "sweep_path")))[0] or "sweep"
+    for j, p in enumerate(names):
+        x = values[:, j]
+        if not np.all(np.isfinite(x)) or len(np.unique(x)) < 2:
+            continue
+        others = [i for i in range(len(names)) if i != j]
+        keys = sorted({tuple(values[r, others]) for r in range(len(x))}, key=lambda k: tuple(np.nan_to_num(k)))
+        for qi, q in enumerate(quantities):
+            by_n = p == "n"
+            fig, axes = plt.subplots(1, 2 if by_n else 1, figsize=(11 if by_n else 7, 4.5), squeeze=False)
+            ax = axes[0][0]
+            for key in keys:
+                rows = [r for r in range(len(x)) if tuple(values[r, others]) == key]
+                rows.sort(key=lambda r: x[r])
+                xs, ys = x[rows], table[rows, qi]
+                label = ", ".join("%s = %g" % (names[i], v) for i, v in zip(others, key)) or None
+                ax.plot(xs, ys, "o-", label=label)
+                if by_n and len(xs) >= 2:
+                    d = np.abs(np.diff(ys))
+                    ok = d > 0
+                    axes[0][1].loglog(xs[1:][ok], d[ok], "o-", label=label)
+                    for a in range(1, len(d)):
+                        if d[a - 1] > 0 and d[a] > 0:
+                            order = np.log(d[a - 1] / d[a]) / np.log(xs[a + 1] / xs[a])
+                            axes[0][1].annotate("%.2f" % order, (xs[a + 1], d[a]), fontsize="small",
+                                                textcoords="offset points", xytext=(4, 4))
+            if by_n:
+                ax.set_xscale("log")
+                finish(axes[0][1], "n (rfes)", "|change of %s| from the previous n" % q)
+                axes[0][1].set_title("observed orders (slopes)", fontsize="medium")
+            finish(ax, p, q)
+            fig.suptitle("%s: %s against %s" % (stem, q, p), fontsize="medium")
+            fig.tight_layout()
+            safe = re.sub(r"[^A-Za-z0-9_.-]+", "_", "%s_vs_%s" % (q, p))
+            save(fig, outdir, "sweep_%s.png" % safe)
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="rfem_plot.py", description=__doc__.splitlines()[0])
     parser.add_argument("result", metavar="RESULT.h5", help="HDF5 file written by rfem")
@@ -367,6 +411,10 @@ def main(argv=None):
             case = os.path.splitext(os.path.basename(text_attr(f, "case_path")))[0]
             runs = {k: Run(f[k], k, case) for k in groups if "time" in f[k]}
             has_refine = "refine" in groups and "n" in f["refine"] and "value" in f["refine"]
+            if text_attr(f, "procedure") == "sweep" and "quantities" in f:
+                os.makedirs(outdir, exist_ok=True)
+                plot_sweep(f, outdir)
+                return 0
             if not runs and not has_refine:
                 raise ValueError("no run groups (with a `time` dataset) and no `refine` group")
             empty = [k for k, r in runs.items() if len(r.t) == 0]

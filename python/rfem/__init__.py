@@ -25,11 +25,13 @@ import subprocess as _subprocess
 import sys as _sys
 
 from . import _rfem
-from ._rfem import Case, CaseError, Model, ModesResult, ResultsError, Run, StaticResult, __version__, build, write_xdmf
+from ._rfem import (Case, CaseError, Model, ModesResult, ResultsError, Run, StaticResult, Sweep, __version__, build,
+                    finished_point, run_point, write_index, write_xdmf)
 
 __all__ = ["Case", "CaseError", "Model", "ModesResult", "ResultsError", "Run", "RunInterrupted", "Runs",
            "StaticResult", "RefineResult", "Tree", "load", "model", "show", "run", "static", "modes", "refine", "plot",
-           "write_xdmf", "animate", "toml_value", "__version__"]
+           "write_xdmf", "animate", "toml_value", "__version__", "Sweep", "SweepResult", "load_sweep", "sweep", "run_point",
+           "finished_point", "write_index"]
 
 
 class RunInterrupted(KeyboardInterrupt):
@@ -199,6 +201,50 @@ def refine(case, ns, quantities, output=None, integration_check=True, rate=None,
     out, error = _rfem._refine(case, list(ns), list(quantities), _os.fspath(output) if output else "", integration_check,
                                rate, joint, threads, progress)
     result = RefineResult(out)
+    _raise(error, result)
+    return result
+
+
+class SweepResult(dict):
+    """A sweep (rfem.sweep): ["parameters"] (names) and ["values"] (points × parameters; NaN where
+    a value is not a number), ["quantities"] (names) and ["table"] (points × quantities; NaN where
+    a point did not complete), ["status"], ["files"] (each point's results file), ["index"];
+    column("peak:u1") is one quantity's column, "n" one parameter's."""
+
+    def column(self, name):
+        if name in self["quantities"]:
+            return self["table"][:, self["quantities"].index(name)]
+        if name in self["parameters"]:
+            return self["values"][:, self["parameters"].index(name)]
+        raise KeyError(f"no quantity or parameter {name!r} (have {self['quantities'] + self['parameters']})")
+
+    @property
+    def completed(self):
+        return all(s == "completed" for s in self["status"])
+
+    warnings = ()
+
+
+def load_sweep(path, output=None):
+    """Reads a sweep file and checks every point before anything runs; returns a Sweep (its
+    .points: overrides, values, file, cost) for rfem.sweep or for your own scheduler
+    (rfem.run_point(sweep, k) in any process or pool, then rfem.write_index(sweep, rows))."""
+    return _rfem.load_sweep(_os.fspath(path), _os.fspath(output) if output else "")
+
+
+def sweep(path, output=None, jobs=0, retry_failed=False, progress=None):
+    """Runs a sweep file as `rfem sweep` does: every point not already finished in its file,
+    longest first, `jobs` at a time (0: the cores), the index rewritten after each. Returns a
+    SweepResult. progress: called with {"done", "failed", "running", "total", "left_s"}. Ctrl-C
+    stops the running points (they run again next time) and raises RunInterrupted with the rows."""
+    s = path if isinstance(path, _rfem.Sweep) else load_sweep(path, output)
+    rows, error, warnings = _rfem._sweep(s, jobs, retry_failed, progress)
+    import numpy as _np
+    result = SweepResult(parameters=list(s.parameters), quantities=list(s.quantities), index=s.index,
+                         values=_np.array([p["values"] for p in s.points], dtype=float).reshape(len(s), -1),
+                         table=_np.array([r["values"] for r in rows], dtype=float).reshape(len(s), -1),
+                         status=[r["status"] for r in rows], files=[p["file"] for p in s.points], rows=rows)
+    result.warnings = warnings
     _raise(error, result)
     return result
 

@@ -226,3 +226,26 @@ def test_urdf_arm_from_python(tmp_path):
     a, b = h5py.File(tmp_path / "py.h5"), h5py.File(tmp_path / "cli.h5")
     for name in ("joint_tau", "tip_deflection", "links/tube/axis_rotation"):
         assert np.array_equal(a["run/" + name][()], b["run/" + name][()]), name
+
+
+def test_sweep_from_python_and_own_pool(tmp_path):
+    """rfem.sweep gives the program's table; the building blocks run the points in a user's own
+    loop (any pool) into the same index; a bad sweep raises the program's message."""
+    sweep = tmp_path / "s.toml"
+    sweep.write_text(f'[sweep]\ncase = "{case_path("kane_spinup.toml")}"\nquantities = ["peak:u1"]\n'
+                     'set = ["simulation.t_end=2"]\n[parameters]\nn = [4, 8]\n"joints.0.input.T" = [10.0, 15.0]\n')
+    code, _, err = program("sweep", str(sweep), "-q", "-o", str(tmp_path / "cli.h5"))
+    assert code == 0, err
+    r = rfem.sweep(sweep, output=tmp_path / "py.h5", jobs=2)
+    assert r.completed and r["parameters"] == ["joints.0.input.T", "n"]
+    assert np.array_equal(r["table"], h5py.File(tmp_path / "cli.h5")["quantities"][()])
+    s = rfem.load_sweep(sweep, output=tmp_path / "own.h5")
+    rows = [rfem.run_point(s, k) for k in range(len(s))]
+    rfem.write_index(s, rows)
+    assert np.array_equal(h5py.File(tmp_path / "own.h5")["quantities"][()], r["table"])
+    assert rfem.finished_point(s, 0)["status"] == "completed"
+    sweep.write_text(sweep.read_text().replace("quantities", "quantity"))
+    code, _, err = program("sweep", str(sweep))
+    with pytest.raises(rfem.CaseError) as e:
+        rfem.load_sweep(sweep)
+    assert code == 2 and str(e.value) == err.strip()[len("rfem: error: "):]

@@ -1,0 +1,85 @@
+#pragma once
+// Parameter sweeps (`rfem sweep SWEEP.toml`, rfem.sweep): a base case and parameters over the
+// paths of `--set`, crossed (grid) or zipped, each point one run of the case's procedure into its
+// own results file, the quantities of `rfem refine` recorded per run, and one index file.
+//
+// The run files are the record: a point whose file holds a completed run of the same overrides
+// (with its quantities) is not run again; one interrupted, killed or missing is; a failed one
+// keeps its reason (and is retried on request). The index — parameters, quantities, statistics,
+// each run's status and an external link to its file — is rebuilt from them after every run,
+// written whole (a temporary file renamed into place), so it is valid at any moment.
+//
+// The building blocks (read_sweep, run_point, finished_point, write_index) let any scheduler run
+// the points: run_sweep's threads on one machine, the program's MPI ranks, a user's own pool.
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rfem/cases/case_file.hpp"
+#include "rfem/studies/common.hpp"
+
+namespace rfem {
+
+struct SweepPoint {
+  std::vector<std::string> overrides;  ///< "key=value" of its parameters, after the sweep's `set`
+  std::vector<double> values;          ///< its parameters' values (NaN where not a number)
+  std::string file;                    ///< its results file
+  double cost = 0.0;                   ///< expected cost, for longest-first order: rfes × t_end
+};
+
+struct Sweep {
+  std::string path, text;          ///< the sweep file and its text
+  std::string case_path;           ///< the base case
+  std::vector<std::string> set;    ///< overrides of every point ([sweep] set)
+  std::vector<std::string> parameters;  ///< the swept keys (`n`: rfes in all, as --n)
+  std::vector<std::string> quantities;  ///< as rfem refine's --quantity
+  bool zip = false;                ///< points: parameters zipped (else every combination)
+  std::string index;               ///< the index file
+  std::string directory;           ///< the run files' directory
+  std::vector<SweepPoint> points;
+};
+
+/// Reads a sweep file; `index` overrides [sweep] output (default: the sweep file's stem + ".h5" in
+/// the current directory, runs in STEM.runs/ beside it). Checks everything before any run: the
+/// file (CaseError "file:line: key: …"), every generated case and its quantities (CaseError
+/// "file: point k (key=value, …): …").
+Sweep read_sweep(const std::string& path, const std::string& index = "");
+
+/// What a point's run gave (or why it did not).
+struct SweepRow {
+  std::string status = "pending";  ///< pending, completed, failed: …, interrupted …
+  double wall_s = NAN, t_reached = NAN;
+  long steps = 0, residual_evals = 0;
+  std::vector<double> values;      ///< per quantity (NaN until completed)
+  bool completed() const { return status == "completed"; }
+};
+
+/// Runs point k into its file (the file is replaced), the quantities recorded in it; threads:
+/// the run's team (0: all). A failure is the row's status, never an exception (a bad value the
+/// case reader refuses included).
+SweepRow run_point(const Sweep& s, int k, const StopToken& stop, int threads = 1, const Warnings& warn = {});
+/// Point k's row from its file if the file holds a finished run (completed or failed) of this
+/// point's overrides; nullopt if it must run (missing, interrupted, killed, another point's).
+std::optional<SweepRow> finished_point(const Sweep& s, int k);
+/// Writes the index (whole, then renamed into place).
+void write_index(const Sweep& s, const std::vector<SweepRow>& rows);
+
+struct SweepProgress {
+  int done = 0, failed = 0, running = 0, total = 0, skipped = 0;
+  double elapsed_s = 0, left_s = NAN;  ///< time left: the remaining cost at the rate so far
+};
+
+struct SweepRequest {
+  int jobs = 0;                   ///< runs at once, one thread each (0: the cores)
+  bool retry_failed = false;      ///< run failed points again
+  StopToken stop;                 ///< ends the running points and the sweep; the index stays valid
+  std::function<void(const SweepProgress&)> progress;  ///< after every point (from the worker that ran it, one call at a time)
+  Warnings warn;
+};
+
+/// Runs every point that must run, longest first, `jobs` at a time; returns all rows (the index
+/// written after each point).
+std::vector<SweepRow> run_sweep(const Sweep& s, const SweepRequest& request);
+
+}  // namespace rfem

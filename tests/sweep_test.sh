@@ -1,0 +1,125 @@
+#!/usr/bin/env bash
+# rfem sweep: a 6-point sweep of Kane's spin-up over n and T gives the same table run one at a
+# time, two at a time and (when built with MPI: $2 = 1) across 3 MPI ranks; its peaks converge with
+# observed order 2 ± 0.3 in n at each T; a sweep killed with SIGKILL, or stopped by SIGINT (exit
+# 130), leaves a valid index and a rerun redoes only what did not finish, ending with the
+# uninterrupted table; bad sweep files give one line and exit 2; rfem plot draws the index.
+set -euo pipefail
+source "$(dirname "$0")/cli_test_env.sh"
+mpi=${2:-0}
+cat > s.toml <<TOML
+[sweep]
+case = "$src/cases/kane_spinup.toml"
+quantities = ["peak:u1", "tau1@3"]
+set = ["simulation.t_end=3"]
+[parameters]
+n = [6, 12, 24]
+"joints.0.input.T" = [10.0, 15.0]
+TOML
+"$rfem" sweep s.toml --jobs 1 -o one.h5 -q 2>/dev/null
+"$rfem" sweep s.toml --jobs 2 -o two.h5 -q 2>/dev/null
+runs="one two"
+if [ "$mpi" = 1 ]; then
+  OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -n 3 --oversubscribe "$rfem" sweep s.toml -o mpi.h5 -q 2>/dev/null
+  runs="one two mpi"
+fi
+RUNS="$runs" /usr/bin/python3 - <<'PY'
+import os, sys
+import h5py, numpy as np
+files = {k: h5py.File(k + ".h5", "r") for k in os.environ["RUNS"].split()}
+one = files["one"]
+q, p = one["quantities"][()], one["parameters"][()]
+checks = {
+    "table": q.shape == (6, 2) and list(one["quantities"].attrs["columns"]) == ["peak:u1", "tau1@3"],
+    # (parameters in key order, the last varying fastest)
+    "parameters": p.tolist() == [[10, 6], [10, 12], [10, 24], [15, 6], [15, 12], [15, 24]],
+    "all completed": list(one.attrs["status"]) == ["completed"] * 6,
+    "external links resolve": all(one[f"runs/run000{k}/run"].attrs["status"] == "completed" for k in range(6)),
+}
+for k, f in files.items():  # each run single-threaded: bit for bit, whoever ran it
+    checks[f"{k}: same table"] = np.array_equal(f["quantities"][()], q)
+for T in (10, 15):  # second-order RFEM: the peak converges with order 2 in n
+    u = q[p[:, 0] == T, 0]
+    order = np.log(abs(u[1] - u[0]) / abs(u[2] - u[1])) / np.log(2)
+    checks[f"T = {T}: order {order:.3f} within 2 ± 0.3"] = abs(order - 2) < 0.3
+checks["a longer spin-up bends less"] = all(q[p[:, 0] == 15, 0] < q[p[:, 0] == 10, 0])
+for k, v in checks.items():
+    print(("ok  " if v else "FAIL"), k)
+sys.exit(0 if all(checks.values()) else 1)
+PY
+# Killed (SIGKILL) and stopped (SIGINT) mid-sweep: points of ~1 s each, one at a time.
+cat > k.toml <<TOML
+[sweep]
+case = "$src/cases/kane_spinup.toml"
+quantities = ["peak:u1"]
+set = ["simulation.t_end=4"]
+[parameters]
+n = [300]
+"joints.0.input.T" = [10.0, 11.0, 12.0, 13.0]
+TOML
+completed() { /usr/bin/python3 -c "import h5py; print(list(h5py.File('$1','r').attrs['status']).count('completed'))" 2>/dev/null || echo 0; }
+for sig in KILL INT; do
+  rm -rf k.h5 k.runs
+  "$rfem" sweep k.toml --jobs 1 -q 2>/dev/null &
+  pid=$!
+  for i in $(seq 1 6000); do [ "$(completed k.h5)" -ge 1 ] && break; sleep 0.05; done
+  kill -$sig "$pid"
+  set +e
+  wait "$pid"
+  code=$?
+  set -e
+  want=$([ $sig = KILL ] && echo 137 || echo 130)
+  [ "$code" = "$want" ] || { echo "FAIL: exit $code on SIG$sig (want $want)"; exit 1; }
+  done_before=$(completed k.h5)
+  [ "$done_before" -ge 1 ] && [ "$done_before" -lt 4 ] || { echo "FAIL: SIG$sig: $done_before points done in the index"; exit 1; }
+  first=$(stat -c %Y.%N k.runs/run0000.h5 2>/dev/null || stat -c %Y k.runs/run0000.h5)
+  "$rfem" sweep k.toml --jobs 1 -q 2>/dev/null
+  [ "$(stat -c %Y.%N k.runs/run0000.h5 2>/dev/null || stat -c %Y k.runs/run0000.h5)" = "$first" ] || { echo "FAIL: SIG$sig: a finished point ran again"; exit 1; }
+  [ "$(completed k.h5)" = 4 ] || { echo "FAIL: SIG$sig: the rerun did not finish the sweep"; exit 1; }
+  echo "ok   SIG$sig after $done_before of 4 points: exit $code, the rerun ran the other $((4 - done_before))"
+done
+cp k.h5 resumed.h5
+rm -rf k.h5 k.runs
+"$rfem" sweep k.toml --jobs 2 -q 2>/dev/null
+/usr/bin/python3 -c "
+import h5py, numpy as np, sys
+ok = np.array_equal(h5py.File('resumed.h5')['quantities'][()], h5py.File('k.h5')['quantities'][()])
+print('ok   resumed table = uninterrupted' if ok else 'FAIL resumed table differs'); sys.exit(0 if ok else 1)"
+# Bad sweep files: one line naming file, line and key (or the point), exit 2.
+bad() {  # expect, then the file's text
+  printf '%s\n' "$2" > bad.toml
+  set +e
+  "$rfem" sweep bad.toml -q > /dev/null 2> bad.err
+  code=$?
+  set -e
+  if [ "$code" != 2 ] || [ "$(wc -l < bad.err)" != 1 ] || ! grep -qF -- "$1" bad.err; then
+    echo "FAIL bad sweep ($1): exit $code: $(cat bad.err)"; exit 1
+  fi
+  echo "ok   bad sweep: $(cat bad.err)"
+}
+head='[sweep]
+case = "'"$src"'/cases/kane_spinup.toml"'
+bad "bad.toml:3: sweep.quantity: unknown key" "$head
+quantity = [\"peak:u1\"]
+[parameters]
+n = [4]"
+bad "parameters.n: must be whole numbers" "$head
+[parameters]
+n = [4.5]"
+bad "has 3 values and 'joints.0.input.T' 2" "$head
+combine = \"zip\"
+[parameters]
+\"joints.0.input.T\" = [5.0, 6.0]
+n = [4, 8, 16]"
+bad "point 1 (joints.0.input.T=-1): " "$head
+[parameters]
+\"joints.0.input.T\" = [5, -1]"
+bad "peak:u9" "$head
+quantities = [\"peak:u9\"]
+[parameters]
+n = [4]"
+bad "parameters: missing table" "$head"
+# The index plots: each quantity against each parameter, orders over n.
+"$rfem" plot one.h5 -o figs > /dev/null
+test -s figs/sweep_peak_u1_vs_n.png && test -s figs/sweep_tau1_3_vs_joints.0.input.T.png || { echo "FAIL: sweep figures"; ls figs; exit 1; }
+echo "ok   rfem plot: $(ls figs | wc -l) figures"
