@@ -78,6 +78,23 @@ for sig in KILL INT; do
   [ "$(completed k.h5)" = 4 ] || { echo "FAIL: SIG$sig: the rerun did not finish the sweep"; exit 1; }
   echo "ok   SIG$sig after $done_before of 4 points: exit $code, the rerun ran the other $((4 - done_before))"
 done
+if [ "$mpi" = 1 ]; then  # a worker rank killed: OpenMPI ends the job; the rerun redoes what did not finish
+  rm -rf k.h5 k.runs
+  OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -n 3 --oversubscribe "$rfem" sweep k.toml -q > /dev/null 2>&1 &
+  pid=$!
+  for i in $(seq 1 6000); do [ "$(completed k.h5)" -ge 1 ] && break; sleep 0.05; done
+  worker=$(pgrep -f "^$rfem sweep k.toml" | tail -1)
+  kill -KILL "$worker"
+  set +e
+  wait "$pid"
+  code=$?
+  set -e
+  done_before=$(completed k.h5)
+  [ "$code" != 0 ] && [ "$done_before" -ge 1 ] && [ "$done_before" -lt 4 ] || { echo "FAIL: killed rank: exit $code, $done_before done"; exit 1; }
+  OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -n 3 --oversubscribe "$rfem" sweep k.toml -q 2>/dev/null
+  [ "$(completed k.h5)" = 4 ] || { echo "FAIL: killed rank: the rerun did not finish the sweep"; exit 1; }
+  echo "ok   a worker rank killed after $done_before of 4 points: mpirun exit $code, the rerun ran the other $((4 - done_before))"
+fi
 cp k.h5 resumed.h5
 rm -rf k.h5 k.runs
 "$rfem" sweep k.toml --jobs 2 -q 2>/dev/null
