@@ -357,23 +357,34 @@ def plot_sweep(f, outdir):
             by_n = p == "n"
             fig, axes = plt.subplots(1, 2 if by_n else 1, figsize=(11 if by_n else 7, 4.5), squeeze=False)
             ax = axes[0][0]
-            for key in keys:
+            many = len(keys) > 6  # then colours along a colour bar of the first other parameter, orders at the ends
+            cmap = plt.get_cmap("viridis")
+            for ki, key in enumerate(keys):
                 rows = [r for r in range(len(x)) if tuple(values[r, others]) == key]
                 rows.sort(key=lambda r: x[r])
                 xs, ys = x[rows], table[rows, qi]
                 label = ", ".join("%s = %g" % (names[i], v) for i, v in zip(others, key)) or None
-                ax.plot(xs, ys, "o-", label=label)
+                style = dict(color=cmap(ki / max(1, len(keys) - 1)), lw=1, ms=3) if many else dict(label=label)
+                ax.plot(xs, ys, "o-", **style)
                 if by_n and len(xs) >= 2:
                     d = np.abs(np.diff(ys))
                     ok = d > 0
-                    axes[0][1].loglog(xs[1:][ok], d[ok], "o-", label=label)
+                    axes[0][1].loglog(xs[1:][ok], d[ok], "o-", **style)
                     for a in range(1, len(d)):
+                        if many and ki not in (0, len(keys) - 1):
+                            continue
                         if d[a - 1] > 0 and d[a] > 0:
                             order = np.log(d[a - 1] / d[a]) / np.log(xs[a + 1] / xs[a])
                             axes[0][1].annotate("%.2f" % order, (xs[a + 1], d[a]), fontsize="small",
                                                 textcoords="offset points", xytext=(4, 4))
+            if many and others:
+                finite = [k[0] for k in keys if np.isfinite(k[0])]
+                if finite:
+                    sm = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(min(finite), max(finite)))
+                    fig.colorbar(sm, ax=axes[0][-1], label=names[others[0]])
             if by_n:
                 ax.set_xscale("log")
+                axes[0][1].xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
                 finish(axes[0][1], "n (rfes)", "|change of %s| from the previous n" % q)
                 axes[0][1].set_title("observed orders (slopes)", fontsize="medium")
             finish(ax, p, q)
