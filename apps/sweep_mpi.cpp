@@ -69,21 +69,12 @@ SweepRow json_row(const nlohmann::json& j) {
 
 // Rank 0: the points to run, one to each rank that asks, and the index after every report.
 std::vector<SweepRow> coordinate(const Sweep& s, const SweepOptions& o, int ranks, const StopToken& stop, bool show) {
-  std::vector<SweepRow> rows(s.points.size());
-  for (SweepRow& r : rows) r.values.assign(s.quantities.size(), NAN);
-  std::vector<int> todo;
+  std::vector<SweepRow> rows;
+  const std::vector<int> todo = plan_sweep(s, o.retry_failed, rows);
   SweepProgress pr;
   pr.total = static_cast<int>(rows.size());
-  for (int k = 0; k < pr.total; ++k) {
-    const auto f = finished_point(s, k);
-    if (f && (f->completed() || !o.retry_failed)) {
-      rows[static_cast<size_t>(k)] = *f;
-      ++(f->completed() ? pr.done : pr.failed);
-    } else {
-      todo.push_back(k);
-    }
-  }
-  std::stable_sort(todo.begin(), todo.end(), [&](int a, int b) { return s.points[static_cast<size_t>(a)].cost > s.points[static_cast<size_t>(b)].cost; });
+  for (const SweepRow& r : rows)
+    if (r.status != "pending") ++(r.completed() ? pr.done : pr.failed);
   write_index(s, rows);
   size_t next = 0;
   int working = ranks - 1;  // ranks that have not been told to stop

@@ -165,7 +165,6 @@ Sweep read_sweep(const std::string& path, const std::string& index) {
   if (count > 1000000) r.fail(&pt, "parameters", fmt::format("{} points are more than a sweep takes (1e6)", count));
   const int width = std::max(4, static_cast<int>(std::to_string(count - 1).size()));
   const Case base = read_case(s.case_path);
-  std::vector<Quantity> qs;
   for (size_t k = 0; k < count; ++k) {
     SweepPoint p;
     size_t rest = k;
@@ -331,26 +330,30 @@ void write_index(const Sweep& s, const std::vector<SweepRow>& rows) {
   if (ec) throw ResultsError(s.index + ": cannot write the index: " + ec.message());
 }
 
-std::vector<SweepRow> run_sweep(const Sweep& s, const SweepRequest& rq) {
-  const int R = static_cast<int>(s.points.size());
-  std::vector<SweepRow> rows(static_cast<size_t>(R));
-  for (SweepRow& r : rows) r.values.assign(s.quantities.size(), NAN);
-  SweepProgress pr;
-  pr.total = R;
+std::vector<int> plan_sweep(const Sweep& s, bool retry_failed, std::vector<SweepRow>& rows) {
+  rows.assign(s.points.size(), SweepRow{});
   std::vector<int> todo;
-  double cost_left = 0.0;
-  for (int k = 0; k < R; ++k) {
+  for (int k = 0; k < static_cast<int>(s.points.size()); ++k) {
+    SweepRow& row = rows[static_cast<size_t>(k)];
+    row.values.assign(s.quantities.size(), NAN);
     const std::optional<SweepRow> f = finished_point(s, k);
-    if (f && (f->completed() || !rq.retry_failed)) {
-      rows[static_cast<size_t>(k)] = *f;
-      ++pr.skipped;
-      ++(f->completed() ? pr.done : pr.failed);
-    } else {
-      todo.push_back(k);
-      cost_left += s.points[static_cast<size_t>(k)].cost;
-    }
+    if (f && (f->completed() || !retry_failed)) row = *f;
+    else todo.push_back(k);
   }
   std::stable_sort(todo.begin(), todo.end(), [&](int a, int b) { return s.points[static_cast<size_t>(a)].cost > s.points[static_cast<size_t>(b)].cost; });
+  return todo;
+}
+
+std::vector<SweepRow> run_sweep(const Sweep& s, const SweepRequest& rq) {
+  std::vector<SweepRow> rows;
+  const std::vector<int> todo = plan_sweep(s, rq.retry_failed, rows);
+  SweepProgress pr;
+  pr.total = static_cast<int>(rows.size());
+  pr.skipped = pr.total - static_cast<int>(todo.size());
+  double cost_left = 0.0;
+  for (int k : todo) cost_left += s.points[static_cast<size_t>(k)].cost;
+  for (const SweepRow& r : rows)
+    if (r.status != "pending") ++(r.completed() ? pr.done : pr.failed);
   write_index(s, rows);
   const int jobs = std::max(1, std::min(rq.jobs > 0 ? rq.jobs : static_cast<int>(std::thread::hardware_concurrency()), static_cast<int>(todo.size())));
   std::mutex lock;

@@ -62,6 +62,9 @@ SweepRow run_point(const Sweep& s, int k, const StopToken& stop, int threads = 1
 /// Point k's row from its file if the file holds a finished run (completed or failed) of this
 /// point's overrides; nullopt if it must run (missing, interrupted, killed, another point's).
 std::optional<SweepRow> finished_point(const Sweep& s, int k);
+/// One row per point, from their files where finished (finished_point; a failed one counts as
+/// finished unless retry_failed); returns the points to run, longest expected first.
+std::vector<int> plan_sweep(const Sweep& s, bool retry_failed, std::vector<SweepRow>& rows);
 /// Writes the index (whole, then renamed into place).
 void write_index(const Sweep& s, const std::vector<SweepRow>& rows);
 
