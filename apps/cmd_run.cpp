@@ -7,6 +7,7 @@
 #include "signals.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/recorders.hpp"
+#include "rfem/studies/resume.hpp"
 
 namespace rfem::app {
 
@@ -48,38 +49,29 @@ class VerboseLog : public RunObserver {
   std::string run_;
 };
 
-}  // namespace
-
-int run_simulation(const Common& c, const std::string& output) {
-  const Case cs = read_checked_case(c);
-  if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: missing table (t_end, output_dt, …) for `rfem run`");
-  if (cs.joints.empty()) throw CaseError(cs.path + ": joints: `rfem run` needs at least one base joint");
-  const auto model = model_of(cs, c.n);
-  const std::vector<JointInput> inputs = joint_inputs(cs, print_warning);  // bad inputs fail before any file is written
-  const bool quiet = c.json || c.quiet;
-  check_run_cost(cs, model, inputs, c);
-  RunRequest rq;
-  const SignalStop signals(rq.stop);
-  ResultsWriter file = create_results(output, describe(cs, c.command_line, to_string(cs.sim.procedure), model->n(), max_threads(c)));
-  if (!quiet)
-    fmt::print("rfem run {}: n = {} rfes{}, m = {} joints, t_end = {} s, {} thread(s) -> {}\n", cs.path, model->n(),
-               model->links.size() > 1 ? fmt::format(" in {} links", model->links.size()) : "", model->m(),
-               cs.sim.options.t_end, max_threads(c), output);
-  ProgressLine progress(quiet);
-  Hdf5Recorder recorder(file);
-  SummaryPrinter summary(progress, quiet);
+// What a run and a resumed run show: the progress line, each run's summary, -v's log.
+struct Console {
+  explicit Console(bool quiet) : progress(quiet), summary(progress, quiet) {}
+  Console(const Console&) = delete;
+  Console& operator=(const Console&) = delete;
+  // The request's threads, checkpoints, progress, observers (after any given) and warnings.
+  void attach(RunRequest& rq, const Common& c, const RunOptions& o) {
+    rq.threads = c.threads;
+    rq.keep_series = false;
+    rq.checkpoint_interval = o.checkpoint;
+    rq.progress = [this](const Progress& p) { progress.show(p); };
+    rq.observers.push_back(&summary);
+    if (c.verbose) rq.observers.push_back(&log);
+    rq.warn = print_warning;
+  }
+  ProgressLine progress;
+  SummaryPrinter summary;
   VerboseLog log;
-  rq.threads = c.threads;
-  rq.keep_series = false;
-  rq.progress = [&](const Progress& p) { progress.show(p); };
-  rq.observers = {&recorder, &summary};
-  if (c.verbose) rq.observers.push_back(&log);
-  rq.warn = print_warning;
-  const std::vector<RunResult> runs = run_case(cs, model, inputs, rq);
-  file.close();
-  const RunResult& last = runs.back();
-  // ParaView's view of every run that stored its poses (also of a failed run: what it computed).
-  const std::vector<std::string> xdmf = write_views(cs, *model, output, print_warning);
+};
+
+// The runs' summaries as JSON or text after the runs, and the exit code of the last run.
+int report(const std::string& case_path, long n, const std::string& output, const std::vector<RunResult>& runs,
+           const std::vector<std::string>& xdmf, const Common& c, bool quiet) {
   if (c.json) {
     nlohmann::json js = nlohmann::json::array();
     for (const auto& r : runs) {
@@ -94,15 +86,70 @@ int run_simulation(const Common& c, const std::string& output) {
       if (!r.peaks.empty())  // the last link's, as with one link
         js.back().update({{"peak_u1", r.peaks.back().u1}, {"peak_u2", r.peaks.back().u2}, {"peak_theta", r.peaks.back().theta}});
     }
-    print_json({{"command", "run"}, {"case", cs.path}, {"n", model->n()}, {"output", output}, {"xdmf", xdmf}, {"runs", js}});
+    print_json({{"command", "run"}, {"case", case_path}, {"n", n}, {"output", output}, {"xdmf", xdmf}, {"runs", js}});
   } else if (!quiet) {
     fmt::print("results in {}\n", output);
     for (const std::string& x : xdmf) fmt::print("ParaView: {}\n", x);
   }
-  if (last.completed()) return 0;
+  if (runs.empty() || runs.back().completed()) return 0;
+  const RunResult& last = runs.back();
   if (last.status.kind == RunStatus::Kind::Interrupted) return 128 + (last.status.signal > 0 ? last.status.signal : 2);
-  fmt::print(stderr, "rfem: error: {}: {}; every completed output step is in {}\n", last.name, last.status.to_string(), output);
+  fmt::print(stderr, "rfem: error: {}: {}; every completed output step is in {}{}\n", last.name, last.status.to_string(), output,
+             last.stats.steps > 0 ? fmt::format(" (rfem run --resume {} goes on from its last checkpoint)", output) : "");
   return 1;
+}
+
+// `rfem run --resume FILE`: the runs the file has left.
+int resume_simulation(const Common& c, const RunOptions& o) {
+  const ResumePlan plan = plan_resume(o.resume);
+  for (const auto& w : plan.cs.warnings) print_warning(w);
+  const bool quiet = c.json || c.quiet;
+  if (!quiet) {
+    fmt::print("rfem run --resume {}: case {}{}, {} thread(s)\n", o.resume, plan.cs.path,
+               plan.n > 0 ? fmt::format(", n = {}", plan.n) : "", max_threads(c));
+    for (const std::string& r : plan.done) fmt::print("{:<10} completed before: kept\n", r);
+    for (const auto& [r, cp] : plan.resume)
+      fmt::print("{:<10} goes on from its checkpoint after output {} ({} outputs kept)\n", r, cp.rows - 1, cp.rows);
+    if (plan.finished()) fmt::print("every run had completed: nothing to do\n");
+  }
+  RunRequest rq;
+  const SignalStop signals(rq.stop);
+  Console console(quiet);
+  console.attach(rq, c, o);
+  const std::vector<RunResult> runs = resume_case(plan, rq);
+  std::vector<std::string> xdmf;
+  if (!runs.empty()) xdmf = write_views(plan.cs, *runs.back().model, o.resume, print_warning);
+  return report(plan.cs.path, runs.empty() ? -1 : runs.back().model->n(), o.resume, runs, xdmf, c, quiet);
+}
+
+}  // namespace
+
+int run_simulation(const Common& c, const RunOptions& o) {
+  if (!o.resume.empty()) return resume_simulation(c, o);
+  const std::string& output = o.output;
+  const Case cs = read_checked_case(c);
+  if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: missing table (t_end, output_dt, …) for `rfem run`");
+  if (cs.joints.empty()) throw CaseError(cs.path + ": joints: `rfem run` needs at least one base joint");
+  const auto model = model_of(cs, c.n);
+  const std::vector<JointInput> inputs = joint_inputs(cs, print_warning);  // bad inputs fail before any file is written
+  const bool quiet = c.json || c.quiet;
+  check_run_cost(cs, model, inputs, c);
+  RunRequest rq;
+  const SignalStop signals(rq.stop);
+  ResultsWriter file = create_results(output, describe(cs, c.command_line, to_string(cs.sim.procedure), model->n(), max_threads(c), c.n));
+  if (!quiet)
+    fmt::print("rfem run {}: n = {} rfes{}, m = {} joints, t_end = {} s, {} thread(s) -> {}\n", cs.path, model->n(),
+               model->links.size() > 1 ? fmt::format(" in {} links", model->links.size()) : "", model->m(),
+               cs.sim.options.t_end, max_threads(c), output);
+  Hdf5Recorder recorder(file);
+  Console console(quiet);
+  rq.observers = {&recorder};
+  console.attach(rq, c, o);
+  const std::vector<RunResult> runs = run_case(cs, model, inputs, rq);
+  file.close();
+  // ParaView's view of every run that stored its poses (also of a failed run: what it computed).
+  const std::vector<std::string> xdmf = write_views(cs, *model, output, print_warning);
+  return report(cs.path, model->n(), output, runs, xdmf, c, quiet);
 }
 
 }  // namespace rfem::app

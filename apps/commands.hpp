@@ -11,6 +11,7 @@
 #include "rfem/results/writer.hpp"
 #include "rfem/solvers/inputs.hpp"
 #include "rfem/studies/common.hpp"
+#include "rfem/studies/runs.hpp"
 #include "rfem/studies/sweep.hpp"
 
 namespace rfem::app {
@@ -47,8 +48,14 @@ struct RefineOptions {
 int run_show(const Common& c);
 int run_static(const Common& c, const ModesOptions& o);
 int run_modes(const Common& c, const ModesOptions& o);
-/// `rfem run`: time integration of the case's [simulation], results to an HDF5 file.
-int run_simulation(const Common& c, const std::string& output);
+struct RunOptions {
+  std::string output;       ///< the results file
+  std::string resume;       ///< --resume RESULTS.h5: continue that file's runs instead
+  double checkpoint = 0.0;  ///< wall time between checkpoints [s] (0: none)
+};
+/// `rfem run`: time integration of the case's [simulation], results to an HDF5 file; or, with
+/// --resume, the runs an interrupted or killed `rfem run` left, from their checkpoints.
+int run_simulation(const Common& c, const RunOptions& o);
 int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o);
 struct SweepOptions {
   std::string path;           ///< the sweep file

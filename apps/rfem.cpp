@@ -78,8 +78,20 @@ int main(int argc, char** argv) {
   add_rate(md);
   auto* rn = app.add_subcommand("run", "time integration of the case's [simulation]; results to HDF5");
   add_common(rn, true);
-  std::string output;
-  rn->add_option("-o,--output", output, "results file (default: the case name with .h5, here)");
+  RunOptions run_options;
+  run_options.checkpoint = rfem::kCheckpointInterval;
+  rn->add_option("-o,--output", run_options.output, "results file (default: the case name with .h5, here)");
+  rn->get_option("case")->required(false);
+  rn->add_option("--resume", run_options.resume,
+                 "continue the runs an interrupted or killed rfem run left in this results file, from their last "
+                 "checkpoints (no case: the file has it)")
+      ->excludes(rn->get_option("case"))
+      ->excludes(rn->get_option("--set"))
+      ->excludes(rn->get_option("--n"))
+      ->excludes(rn->get_option("-o"));
+  rn->add_option("--checkpoint", run_options.checkpoint,
+                 fmt::format("seconds of wall time between checkpoints (0: none; default {:g})", rfem::kCheckpointInterval))
+      ->check(CLI::NonNegativeNumber);
   auto* pl = app.add_subcommand("plot", "PNG figures of a results file (the paper's Figures 5-8, runs, refinement)");
   std::string plot_file, plot_dir;
   pl->add_option("results", plot_file, "results file (HDF5) from rfem run or rfem refine")->required();
@@ -176,11 +188,13 @@ int main(int argc, char** argv) {
       return run_animate(args);
     }
     if (rn->parsed()) {
-      if (output.empty()) {
+      if (run_options.resume.empty() && common.case_path.empty())
+        throw rfem::CaseError("run: a case file (or --resume RESULTS.h5) is required");
+      if (run_options.output.empty() && run_options.resume.empty()) {
         std::string stem = common.case_path.substr(common.case_path.find_last_of('/') + 1);
-        output = stem.substr(0, stem.rfind('.')) + ".h5";
+        run_options.output = stem.substr(0, stem.rfind('.')) + ".h5";
       }
-      return run_simulation(common, output);
+      return run_simulation(common, run_options);
     }
     if (sw->parsed()) return run_sweep_command(so, sweep_json, sweep_quiet);
     if (rf->parsed()) {

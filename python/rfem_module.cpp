@@ -19,6 +19,7 @@
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/modes_study.hpp"
 #include "rfem/studies/recorders.hpp"
+#include "rfem/studies/resume.hpp"
 #include "rfem/studies/refine.hpp"
 #include "rfem/studies/runs.hpp"
 #include "rfem/studies/show.hpp"
@@ -85,14 +86,15 @@ struct Pending {
   }
 };
 
-FileDescription python_description(const Case& cs, const std::string& call, const std::string& procedure, long n, long threads) {
+FileDescription python_description(const Case& cs, const std::string& call, const std::string& procedure, long n, long threads,
+                                   long n_option = -1) {
   std::string argv;
   try {
     py::gil_scoped_acquire gil;
     for (auto a : py::module_::import("sys").attr("argv")) argv += (argv.empty() ? "" : " ") + py::str(a).cast<std::string>();
   } catch (...) {
   }
-  return describe(cs, argv + (argv.empty() ? "" : " ") + "(Python " + call + ")", procedure, n, threads);
+  return describe(cs, argv + (argv.empty() ? "" : " ") + "(Python " + call + ")", procedure, n, threads, n_option);
 }
 
 py::dict stats_dict(const IntegratorStats& s) {
@@ -123,6 +125,21 @@ JointRate joint_rate(std::optional<double> rate, int joint) {
   r.rate = rate.value_or(0.0);
   r.joint = joint;
   return r;
+}
+
+// A run request from Python: progress and Ctrl-C through `pending`, warnings collected.
+RunRequest python_request(const std::shared_ptr<Pending>& pending, py::object progress, int threads, bool keep_series,
+                          double checkpoint, std::vector<std::string>& warnings) {
+  pending->progress = std::move(progress);
+  RunRequest rq;
+  rq.threads = threads;
+  rq.keep_series = keep_series;
+  rq.checkpoint_interval = checkpoint;
+  rq.stop = pending->stop;
+  rq.progress = [pending](const Progress& p) { pending->beat(&p); };
+  rq.progress_interval = 0.1;
+  rq.warn = [&warnings](const std::string& w) { warnings.push_back(w); };
+  return rq;
 }
 
 }  // namespace
@@ -239,19 +256,12 @@ PYBIND11_MODULE(_rfem, m) {
       });
 
   m.def("_run", [](const Case& cs, int n, const std::string& output, const std::vector<std::string>& runs, int threads,
-                   bool keep_series, py::object progress) {
+                   bool keep_series, py::object progress, double checkpoint) {
     auto pending = std::make_shared<Pending>();
-    pending->progress = std::move(progress);
-    RunRequest rq;
-    rq.n = n;
-    rq.threads = threads;
-    rq.runs = run_names(runs);
-    rq.keep_series = keep_series;
-    rq.stop = pending->stop;
-    rq.progress = [pending](const Progress& p) { pending->beat(&p); };
-    rq.progress_interval = 0.1;
     std::vector<std::string> warnings;
-    rq.warn = [&warnings](const std::string& w) { warnings.push_back(w); };
+    RunRequest rq = python_request(pending, std::move(progress), threads, keep_series, checkpoint, warnings);
+    rq.n = n;
+    rq.runs = run_names(runs);
     std::vector<RunResult> results;
     {
       py::gil_scoped_release release;
@@ -265,7 +275,7 @@ PYBIND11_MODULE(_rfem, m) {
         Parallelism p;
         p.threads = threads;
         file = std::make_unique<ResultsWriter>(
-            output, python_description(cs, "rfem.run", to_string(cs.sim.procedure), model->n(), p.max_threads()));
+            output, python_description(cs, "rfem.run", to_string(cs.sim.procedure), model->n(), p.max_threads(), n));
         recorder = std::make_unique<Hdf5Recorder>(*file);
         rq.observers.push_back(recorder.get());
       }
@@ -281,7 +291,29 @@ PYBIND11_MODULE(_rfem, m) {
     pending->progress = py::none();
     return py::make_tuple(out, error, warnings);
   }, py::arg("case"), py::arg("n"), py::arg("output"), py::arg("runs"), py::arg("threads"), py::arg("keep_series"),
-     py::arg("progress"));
+     py::arg("progress"), py::arg("checkpoint"));
+
+  m.attr("CHECKPOINT_INTERVAL") = kCheckpointInterval;
+
+  m.def("_resume", [](const std::string& path, int threads, bool keep_series, py::object progress, double checkpoint) {
+    auto pending = std::make_shared<Pending>();
+    std::vector<std::string> warnings;
+    RunRequest rq = python_request(pending, std::move(progress), threads, keep_series, checkpoint, warnings);
+    std::vector<RunResult> results;
+    std::vector<std::string> done;
+    {
+      py::gil_scoped_release release;
+      const ResumePlan plan = plan_resume(path);
+      done = plan.done;
+      results = resume_case(plan, rq);
+      if (!results.empty()) write_views(plan.cs, *results.back().model, path, rq.warn);
+    }
+    py::list out;
+    for (auto& r : results) out.append(std::make_shared<RunResult>(std::move(r)));
+    py::object error = pending->error;
+    pending->progress = py::none();
+    return py::make_tuple(out, error, warnings, done);
+  }, py::arg("path"), py::arg("threads"), py::arg("keep_series"), py::arg("progress"), py::arg("checkpoint"));
 
   m.def("write_xdmf", [](const std::string& results, const std::vector<std::string>& runs) {
     py::gil_scoped_release release;

@@ -118,4 +118,22 @@ std::string ResultsReader::attribute(const std::string& object, const std::strin
   return fallback;
 }
 
+double ResultsReader::number(const std::string& object, const std::string& key, double fallback) const {
+  const h5::Quiet quiet;
+  if (object != "/" && !has(object)) return fallback;
+  const h5::Handle o = h5::object(H5Oopen(impl_->file, object.c_str(), H5P_DEFAULT), impl_->path + ": " + object);
+  if (H5Aexists(o, key.c_str()) <= 0) return fallback;
+  const hid_t a = H5Aopen(o, key.c_str(), H5P_DEFAULT);
+  if (a < 0) return fallback;
+  const h5::Handle attr = h5::attribute(a, impl_->path + ": " + key);
+  const h5::Handle t = h5::type(H5Aget_type(attr), impl_->path + ": " + key);
+  const h5::Handle s = h5::space(H5Aget_space(attr), impl_->path + ": " + key);
+  const H5T_class_t c = H5Tget_class(t);
+  double v = fallback;
+  if ((c == H5T_INTEGER || c == H5T_FLOAT) && H5Sget_simple_extent_npoints(s) == 1 && H5Aread(attr, H5T_NATIVE_DOUBLE, &v) < 0)
+    v = fallback;
+  h5::reason();
+  return v;
+}
+
 }  // namespace rfem

@@ -2,7 +2,9 @@
 // Reading a results file back: the series of a run group and its string attributes, every shape
 // checked (a file that rfem did not write, or another program changed, gives ResultsError, never a
 // read past an array).
+#include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -41,10 +43,23 @@ class ResultsReader {
   std::vector<std::string> children(const std::string& group) const;
   /// The string attribute `key` of `object` ("/" for the file); `fallback` if there is none.
   std::string attribute(const std::string& object, const std::string& key, const std::string& fallback = "") const;
+  /// A numeric attribute (`fallback` if missing or not a number).
+  double number(const std::string& object, const std::string& key, double fallback = NAN) const;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// A run's last checkpoint in its group (dataset `checkpoint`): the output rows and flexible rows it
+/// covers and the state to resume from (studies/checkpoints.hpp packs it). Two slots written in
+/// turn, each with a checksum, so a run killed while writing one still has the other.
+struct Checkpoint {
+  long rows = 0, flexible_rows = 0;
+  long sequence = 0;  ///< how many checkpoints the run wrote before this one
+  std::vector<double> state;
+};
+/// The newest intact checkpoint of run group `run`, if it has one.
+std::optional<Checkpoint> read_checkpoint(const ResultsReader& file, const std::string& run);
 
 }  // namespace rfem

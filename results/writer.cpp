@@ -13,104 +13,11 @@
 #include <filesystem>
 #include <variant>
 
-#include "rfem/results/h5_impl.hpp"
+#include "rfem/results/writer_impl.hpp"
 #include "rfem/version.hpp"
 
 namespace rfem {
 
-namespace {
-
-double now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-h5::Handle latest_fapl() {  // SWMR needs the latest file format
-  h5::Handle fapl = h5::plist(H5Pcreate(H5P_FILE_ACCESS), "file access list");
-  h5::check(H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST), "file access list");
-  return fapl;
-}
-
-}  // namespace
-
-// Room a run's group needs besides its chunks of rows: metadata flushes, the attributes written at
-// its end, closing the file (measured: a run group's metadata takes 20–40 kB).
-constexpr long long kMargin = 64 * 1024;
-
-struct ResultsWriter::File {
-  std::string path;
-  h5::Handle id;
-  int lock_fd = -1;  // holds the open-file-description lock that keeps other rfem writers out
-  bool swmr = false;
-  using Value = std::variant<std::string, double, long>;
-  struct Pending {
-    std::string object, key;
-    Value value;
-  };
-  std::vector<Pending> pending;  // attributes that wait for the end of SWMR mode
-
-  std::string what(const std::string& doing) const { return path + ": " + doing; }
-
-  ~File() {
-    if (lock_fd >= 0) ::close(lock_fd);
-  }
-
-  // Refuses (ResultsError) a write of `bytes` more that the disk or the file size limit (ulimit -f)
-  // cannot take. HDF5 cannot recover from a failed write (its file is left unreadable, and its own
-  // clean-up at exit crashes), so writes stop while there is still room to record why.
-  void require(long long bytes) const {
-    const std::string dir = std::filesystem::path(path).parent_path().string();
-    struct statvfs fs {};
-    if (statvfs(dir.empty() ? "." : dir.c_str(), &fs) == 0) {
-      const long long free = static_cast<long long>(fs.f_bavail) * static_cast<long long>(fs.f_frsize);
-      if (free < bytes)
-        throw ResultsError("cannot write " + path + ": the disk is full (" + std::to_string(free / 1024) + " kB free, " +
-                           std::to_string(bytes / 1024) + " kB needed for the next rows)");
-    }
-    struct rlimit rl {};
-    struct stat st {};
-    if (getrlimit(RLIMIT_FSIZE, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY && ::stat(path.c_str(), &st) == 0 &&
-        static_cast<long long>(st.st_size) + bytes > static_cast<long long>(rl.rlim_cur))
-      throw ResultsError("cannot write " + path + ": the file size limit (ulimit -f, " + std::to_string(rl.rlim_cur / 1024) +
-                         " kB) is reached");
-  }
-
-  void attribute(const std::string& object, const std::string& key, const Value& value) {
-    if (swmr) {
-      pending.push_back({object, key, value});
-      return;
-    }
-    const h5::Handle obj = h5::object(H5Oopen(id, object.c_str(), H5P_DEFAULT), what("opening " + object));
-    try {
-      std::visit([&](const auto& v) { h5::write_attribute(obj, key, v); }, value);
-    } catch (const ResultsError& e) {
-      throw ResultsError(what(object + " " + e.what()));
-    }
-  }
-  void flush() { h5::check(H5Fflush(id, H5F_SCOPE_GLOBAL), what("flushing")); }
-  void begin_swmr() {
-    if (swmr) return;
-    flush();
-    swmr = H5Fstart_swmr_write(id) >= 0;  // without SWMR the run is still written, just not watchable
-    h5::reason();                          // (clears the stack of a refusal)
-  }
-  // Leaves SWMR mode if in it, and writes the attributes that waited for that.
-  void end_swmr() {
-    if (swmr) {
-      swmr = false;
-      id.close(what("closing after SWMR writing"));
-      // Readers that watched the run (SWMR, shared locks) may still have the file open: reopen
-      // without file locks for the attributes and the next run's group (a watcher reopens to see them).
-      const h5::Handle fapl = latest_fapl();
-      h5::check(H5Pset_file_locking(fapl, false, true), what("reopening"));
-      id = h5::file(H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl), what("cannot reopen the results file"));
-    }
-    if (pending.empty()) return;
-    std::vector<Pending> p;
-    p.swap(pending);
-    for (const auto& x : p) attribute(x.object, x.key, x.value);
-    flush();
-  }
-};
 
 namespace {
 
@@ -162,7 +69,25 @@ ResultsWriter::ResultsWriter(const std::string& path, const FileDescription& d) 
   file_->attribute("/", "overrides", d.overrides);
   file_->attribute("/", "procedure", d.procedure);
   if (d.n >= 0) file_->attribute("/", "n", d.n);
+  if (d.n_option >= 0) file_->attribute("/", "n_option", d.n_option);
   file_->attribute("/", "threads", d.threads);
+}
+
+ResultsWriter::ResultsWriter(const std::string& path, Reopen) : file_(std::make_shared<File>()) {
+  const h5::Quiet quiet;
+  file_->path = path;
+  if (H5Fis_hdf5(path.c_str()) <= 0) {
+    h5::reason();
+    throw ResultsError(path + ": not an HDF5 results file");
+  }
+  file_->lock_fd = claim(path, "");
+  file_->require(kMargin);
+  const h5::Handle fapl = latest_fapl();
+  // A run killed while writing left the file marked as open by a (SWMR) writer: clear the mark, as
+  // h5clear -s does (HDF5's file-access property for it; SWMR kept the file consistent).
+  hbool_t clear = true;
+  h5::check(H5Pset(fapl, "clear_status_flags", &clear), path + ": reopening");
+  file_->id = h5::file(H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl), path + ": cannot reopen the results file to resume it");
 }
 
 ResultsWriter::~ResultsWriter() {
@@ -273,95 +198,6 @@ void ResultsWriter::write_external_link(const std::string& name, const std::stri
 
 // ---------------------------------------------------------------------------------------------
 
-struct RunWriter::Impl {
-  std::shared_ptr<ResultsWriter::File> file;
-  std::string name;
-  std::shared_ptr<const Model> model;
-  RunLayout layout;
-  struct Series {
-    h5::Handle dset;
-    int cols = 1;
-    long chunk_rows = 1;
-    std::string name;
-  };
-  std::vector<Series> series, flexible;
-  h5::Handle group, status;
-  long rows = 0, flex_rows = 0;
-  double last_flush = 0.0;
-  long long unflushed = 0;  // bytes of chunks started since the last flush
-  std::vector<std::vector<double>> scratch;
-
-  // File space the rows `row` of these series will allocate: a new chunk for each that starts one.
-  static long long new_chunks(const std::vector<Series>& v, long row) {
-    long long bytes = 0;
-    for (const Series& s : v)
-      if (row % s.chunk_rows == 0) bytes += static_cast<long long>(s.chunk_rows) * s.cols * static_cast<long long>(sizeof(double));
-    return bytes;
-  }
-
-  std::string what(const std::string& doing) const { return file->what(doing + " " + name); }
-
-  Series add_series(const SeriesInfo& info) {
-    const std::string w = what("creating " + info.name + " in");
-    const hsize_t dims[2] = {0, static_cast<hsize_t>(info.width())};
-    const hsize_t maxd[2] = {H5S_UNLIMITED, dims[1]};
-    const h5::Handle space = h5::space(H5Screate_simple(2, dims, maxd), w);
-    const h5::Handle plist = h5::plist(H5Pcreate(H5P_DATASET_CREATE), w);
-    const hsize_t chunk[2] = {std::max<hsize_t>(1, std::min<hsize_t>(256, (1 << 16) / dims[1])), dims[1]};
-    h5::check(H5Pset_chunk(plist, 2, chunk), w);
-    const h5::Handle lcpl = h5::plist(H5Pcreate(H5P_LINK_CREATE), w);  // "links/NAME/tip" creates its groups
-    h5::check(H5Pset_create_intermediate_group(lcpl, 1), w);
-    Series s;
-    s.dset = h5::dataset(H5Dcreate2(group, info.name.c_str(), H5T_NATIVE_DOUBLE, space, lcpl, plist, H5P_DEFAULT), w);
-    h5::write_attribute(s.dset, "columns", info.columns);
-    h5::write_attribute(s.dset, "units", info.units);
-    if (!info.description.empty()) h5::write_attribute(s.dset, "description", info.description);
-    s.cols = info.width();
-    s.chunk_rows = static_cast<long>(chunk[0]);
-    s.name = info.name;
-    return s;
-  }
-
-  void write_row(Series& s, long row, const double* data) {
-    const std::string w = what("writing " + s.name + " of");
-    const hsize_t size[2] = {static_cast<hsize_t>(row + 1), static_cast<hsize_t>(s.cols)};
-    h5::check(H5Dset_extent(s.dset, size), w);
-    const h5::Handle fspace = h5::space(H5Dget_space(s.dset), w);
-    const hsize_t start[2] = {static_cast<hsize_t>(row), 0}, count[2] = {1, static_cast<hsize_t>(s.cols)};
-    h5::check(H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start, nullptr, count, nullptr), w);
-    const h5::Handle mspace = h5::space(H5Screate_simple(2, count, nullptr), w);
-    h5::check(H5Dwrite(s.dset, H5T_NATIVE_DOUBLE, mspace, fspace, H5P_DEFAULT, data), w);
-  }
-
-  void set_status(const std::string& text) {
-    if (!status.valid()) return;
-    const h5::Handle type = h5::type(H5Tcopy(H5T_C_S1), what("status of"));
-    h5::check(H5Tset_size(type, 256), what("status of"));
-    char buf[256] = {0};
-    text.copy(buf, 255);
-    h5::check(H5Dwrite(status, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf), what("writing the status of"));
-  }
-
-  void flush() {
-    if (!group.valid()) return;
-    if (file->swmr) {
-      for (auto* v : {&series, &flexible})
-        for (auto& s : *v) h5::check(H5Dflush(s.dset), what("flushing " + s.name + " of"));
-      if (status.valid()) h5::check(H5Dflush(status), what("flushing the status of"));
-    }
-    file->flush();
-    last_flush = now_s();
-    unflushed = 0;
-  }
-
-  // Closes the datasets and the group (before the file leaves SWMR mode); never throws.
-  void close_quietly() {
-    for (auto* v : {&series, &flexible})
-      for (auto& s : *v) s.dset.reset();
-    status.reset();
-    group.reset();
-  }
-};
 
 RunWriter::RunWriter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
@@ -377,6 +213,27 @@ RunWriter::~RunWriter() {
 
 long RunWriter::samples() const { return impl_->rows; }
 
+namespace writer_detail {
+
+void queue_run_description(ResultsWriter::File& f, const std::string& name, const RunDescription& d) {
+  // What the run is, written at its end (SWMR allows no new attributes while it goes).
+  const IntegratorOptions& o = d.options;
+  f.pending.push_back({name, "rtol", o.rtol});
+  f.pending.push_back({name, "atol", o.atol});
+  f.pending.push_back({name, "atol_velocity", o.atol_velocity});
+  f.pending.push_back({name, "max_step", o.max_step});
+  f.pending.push_back({name, "integrator", integrator_name(o.kind)});
+  if (o.kind == IntegratorKind::Esdirk) f.pending.push_back({name, "method", o.esdirk_table});
+  else f.pending.push_back({name, "max_order", static_cast<long>(o.max_order)});
+  f.pending.push_back({name, "output_dt", o.output_dt});
+  f.pending.push_back({name, "threads", d.threads});
+  std::string kinds;
+  for (const auto& k : d.inputs) kinds += (kinds.empty() ? "" : ",") + k;
+  f.pending.push_back({name, "inputs", kinds});
+}
+
+}  // namespace writer_detail
+
 std::unique_ptr<RunWriter> ResultsWriter::begin_run(const std::string& name, std::shared_ptr<const Model> model,
                                                    const RunDescription& d) {
   if (!model) throw std::invalid_argument("ResultsWriter::begin_run: no model");
@@ -384,15 +241,14 @@ std::unique_ptr<RunWriter> ResultsWriter::begin_run(const std::string& name, std
   File& f = *file_;
   f.end_swmr();  // a new group: not while another run's SWMR lasts
   f.require(2 * kMargin);
-  auto p = std::make_unique<RunWriter::Impl>();
+  auto p = RunWriter::Impl::make(file_, name, model, d);
   RunWriter::Impl& w = *p;
-  w.file = file_;
-  w.name = name;
-  w.model = model;
-  w.layout = run_layout(*model, d.flexible_every);
   const Model& M = *model;
   const h5::Handle lcpl = h5::plist(H5Pcreate(H5P_LINK_CREATE), f.what("creating group " + name));
   h5::check(H5Pset_create_intermediate_group(lcpl, 1), f.what("creating group " + name));  // "n60/kinematic"
+  if (H5Lexists(f.id, name.c_str(), H5P_DEFAULT) > 0)  // (a reopened file: the run starts again)
+    h5::check(H5Ldelete(f.id, name.c_str(), H5P_DEFAULT), f.what("removing the old group " + name));
+  h5::reason();
   w.group = h5::group(H5Gcreate2(f.id, name.c_str(), lcpl, H5P_DEFAULT, H5P_DEFAULT), f.what("cannot create group " + name));
   for (const SeriesInfo& s : w.layout.series) w.series.push_back(w.add_series(s));
   for (const SeriesInfo& s : w.layout.flexible) w.flexible.push_back(w.add_series(s));
@@ -431,20 +287,8 @@ std::unique_ptr<RunWriter> ResultsWriter::begin_run(const std::string& name, std
   if (!link_names.empty()) h5::write_attribute(w.group, "link_names", link_names);
   h5::write_attribute(w.group, "status", std::string("running"));
   w.set_status("running");
-  // What the run is, written at its end (SWMR allows no new attributes while it goes).
-  const IntegratorOptions& o = d.options;
-  f.pending.push_back({name, "rtol", o.rtol});
-  f.pending.push_back({name, "atol", o.atol});
-  f.pending.push_back({name, "atol_velocity", o.atol_velocity});
-  f.pending.push_back({name, "max_step", o.max_step});
-  f.pending.push_back({name, "integrator", integrator_name(o.kind)});
-  if (o.kind == IntegratorKind::Esdirk) f.pending.push_back({name, "method", o.esdirk_table});
-  else f.pending.push_back({name, "max_order", static_cast<long>(o.max_order)});
-  f.pending.push_back({name, "output_dt", o.output_dt});
-  f.pending.push_back({name, "threads", d.threads});
-  std::string kinds;
-  for (const auto& k : d.inputs) kinds += (kinds.empty() ? "" : ",") + k;
-  f.pending.push_back({name, "inputs", kinds});
+  w.create_checkpoints();
+  writer_detail::queue_run_description(f, name, d);
   f.begin_swmr();
   w.last_flush = now_s();
   return std::make_unique<RunWriter>(std::move(p));

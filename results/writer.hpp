@@ -8,6 +8,7 @@
 // when SWMR ends (the file is closed and reopened). Every HDF5 call is checked: a failure throws
 // ResultsError naming the file. Layout documented in README.md ("Results").
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,7 @@ struct FileDescription {
   std::string overrides;       ///< the --set values, one per line
   std::string procedure;       ///< single | paper | refine
   long n = -1;                 ///< rfes of every run in the file (−1: not one n, as in a refinement)
+  long n_option = -1;          ///< the n the runs were asked for (0: the case's own; −1: not one run's)
   long threads = 0;            ///< the largest thread team of the runs
 };
 
@@ -41,11 +43,17 @@ struct RunDescription {
 
 class RunWriter;
 
+/// Opens an existing results file to continue its runs (ResultsWriter's resuming constructor).
+struct Reopen {};
+
 /// A results file, created (or truncated) on construction. Movable, not copyable; closing never
 /// throws from the destructor (close() reports a failure).
 class ResultsWriter {
  public:
   ResultsWriter(const std::string& path, const FileDescription& description);
+  /// An existing results file, for resume_run (also a file a killed run left: its SWMR flags are
+  /// cleared). Refused like a new file if another rfem run writes it.
+  ResultsWriter(const std::string& path, Reopen);
   ~ResultsWriter();
   ResultsWriter(ResultsWriter&&) noexcept;
   ResultsWriter& operator=(ResultsWriter&&) noexcept;
@@ -56,6 +64,11 @@ class ResultsWriter {
   /// writer, which must be finished before the next run begins.
   std::unique_ptr<RunWriter> begin_run(const std::string& name, std::shared_ptr<const Model> model,
                                        const RunDescription& description);
+  /// Run group `name` reopened at checkpoint `from`: its series cut back to the rows the checkpoint
+  /// covers, the run `running` again; the returned writer goes on from there. The group must have
+  /// been written by begin_run with the same model and description.
+  std::unique_ptr<RunWriter> resume_run(const std::string& name, std::shared_ptr<const Model> model,
+                                        const RunDescription& description, const Checkpoint& from);
   /// The group `refine`: n and, per quantity, refine/q<k> with value, change, order, richardson
   /// and its assessment; the first quantity's datasets also directly in `refine`.
   void write_refinement(const std::vector<std::string>& quantities, const std::vector<int>& ns,
@@ -86,6 +99,8 @@ class RunWriter {
   RunWriter(const RunWriter&) = delete;
   RunWriter& operator=(const RunWriter&) = delete;
   void append(const OutputSample& s);
+  /// Records a checkpoint covering every row appended so far (flushed first), in the older slot.
+  void checkpoint(const std::vector<double>& state);
   /// Writes the status, the integrator's statistics, the wall time and any warnings about the
   /// solution (attribute `warnings`, one per line), and leaves SWMR mode.
   void finish(const RunOutcome& outcome, double wall_s, const std::vector<std::string>& warnings = {});

@@ -134,25 +134,42 @@ RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, S
   RunOutcome out;
 
   VecX y0 = VecX::Zero(N), yp0 = VecX::Zero(N), qu, vu;
-  try {  // the start can fail like any step: a status, not an exception
-    eq.initial_state(qu, vu, opts.initial == InitialState::Static);
-    y0.head(u) = qu;
-    y0.segment(u, u) = vu;
-    const VecX a0 = eq.accelerations(0.0, qu.data(), vu.data());
-    yp0.head(u) = vu;
-    yp0.segment(u, u) = a0;
-    p.r.resize(u);
-    const Power P0 = eq.residual(0.0, qu.data(), vu.data(), a0.data(), p.r.data());
-    yp0[2 * u] = P0.dissipation;
-    yp0[2 * u + 1] = P0.input;
-    if (!y0.allFinite() || !yp0.allFinite()) throw std::runtime_error("the initial state is not finite (check the inputs' values)");
-    if (!emit(eq.sample(0.0, qu.data(), vu.data(), a0.data(), 0.0, 0.0))) {
-      out.status = emit.failure();
+  // A resumed run restarts IDA at its checkpoint (order 1, a fresh history): the same solution
+  // within the tolerances, not bit for bit.
+  const IntegratorState* resume = emit.resume();
+  const double t0 = resume ? resume->t : 0.0;
+  IntegratorStats before;  // counters of the run before the checkpoint
+  p.r.resize(u);
+  if (resume) {
+    if (resume->q.size() != u || resume->v.size() != u || resume->a.size() != u)
+      throw std::invalid_argument("the state to resume from has " + std::to_string(resume->q.size()) +
+                                  " unknowns, the model " + std::to_string(u));
+    if (resume->next_output < 1 || resume->next_output > n_out + 1)
+      throw std::invalid_argument("the state to resume from does not fit the run's outputs (another t_end or output_dt?)");
+    y0 << resume->q, resume->v, resume->dissipated, resume->input_work;
+    yp0 << resume->v, resume->a, resume->power.dissipation, resume->power.input;
+    before = resume->stats;
+    out.t_reached = output_time(opts, resume->next_output - 1);
+  } else {
+    try {  // the start can fail like any step: a status, not an exception
+      eq.initial_state(qu, vu, opts.initial == InitialState::Static);
+      y0.head(u) = qu;
+      y0.segment(u, u) = vu;
+      const VecX a0 = eq.accelerations(0.0, qu.data(), vu.data());
+      yp0.head(u) = vu;
+      yp0.segment(u, u) = a0;
+      const Power P0 = eq.residual(0.0, qu.data(), vu.data(), a0.data(), p.r.data());
+      yp0[2 * u] = P0.dissipation;
+      yp0[2 * u + 1] = P0.input;
+      if (!y0.allFinite() || !yp0.allFinite()) throw std::runtime_error("the initial state is not finite (check the inputs' values)");
+      if (!emit(eq.sample(0.0, qu.data(), vu.data(), a0.data(), 0.0, 0.0))) {
+        out.status = emit.failure();
+        return out;
+      }
+    } catch (const std::exception& e) {
+      out.status = RunStatus::failed(at_start(e.what()));
       return out;
     }
-  } catch (const std::exception& e) {
-    out.status = RunStatus::failed(at_start(e.what()));
-    return out;
   }
 
   IdaHandles h;
@@ -164,7 +181,8 @@ RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, S
   h.ida = IDACreate(h.ctx.get());
   if (!h.ida) throw std::runtime_error("IDACreate failed");
   p.ida = h.ida;
-  check(IDAInit(h.ida, residual, 0.0, h.y, h.yp), "IDAInit");
+  check(IDAInit(h.ida, residual, t0, h.y, h.yp), "IDAInit");
+  if (resume) check(IDASetInitStep(h.ida, resume->h), "IDASetInitStep");
   N_Vector abstol = N_VNew_Serial(N, h.ctx.get());
   if (!abstol) throw std::runtime_error("N_VNew_Serial failed");
   double* at = N_VGetArrayPointer(abstol);
@@ -204,8 +222,12 @@ RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, S
     IDAGetNumNonlinSolvConvFails(h.ida, &out.stats.newton_fails);
     IDAGetNumErrTestFails(h.ida, &out.stats.error_test_fails);
     IDAGetLastStep(h.ida, &out.stats.last_step);
+    for (auto [sum, was] : {std::pair{&out.stats.steps, before.steps}, {&out.stats.residual_evals, before.residual_evals},
+                            {&out.stats.factorizations, before.factorizations}, {&out.stats.newton_iters, before.newton_iters},
+                            {&out.stats.newton_fails, before.newton_fails}, {&out.stats.error_test_fails, before.error_test_fails}})
+      *sum += was;
   };
-  for (long k = 1; k <= n_out; ++k) {
+  for (long k = resume ? resume->next_output : 1; k <= n_out; ++k) {
     const double tout = output_time(opts, k);
     sunrealtype tret = 0.0;
     const int flag = IDASolve(h.ida, tout, &tret, h.y, h.yp, IDA_NORMAL);
@@ -248,6 +270,28 @@ RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, S
       return out;
     }
     out.t_reached = tret;
+    // A checkpoint at the output: IDA's state there with the accelerations and powers of the
+    // equations (its interpolated y' is first order), and the next step it would take.
+    const bool saved = emit.checkpoint([&] {
+      IntegratorState x;
+      x.t = tret;
+      x.q = Eigen::Map<const VecX>(y, u);
+      x.v = Eigen::Map<const VecX>(y + u, u);
+      x.a = eq.accelerations(tret, y, y + u);
+      x.power = eq.residual(tret, y, y + u, x.a.data(), p.r.data());
+      x.dissipated = y[2 * u];
+      x.input_work = y[2 * u + 1];
+      double h_next = 0.0;
+      IDAGetCurrentStep(h.ida, &h_next);
+      x.h = h_next > 0 ? h_next : out.stats.last_step;
+      x.next_output = k + 1;
+      x.stats = out.stats;
+      return x;
+    });
+    if (!saved) {
+      out.status = emit.failure();
+      return out;
+    }
   }
   out.status = RunStatus::completed();
   return out;

@@ -140,24 +140,39 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
   IntegratorStats& st = out.stats;
 
   // The start (static equilibrium, initial accelerations) can fail like any step: a status, not an
-  // exception.
+  // exception. A resumed run starts from its checkpoint instead, its outputs so far delivered.
+  const IntegratorState* resume = emit.resume();
   VecX q, v, a, r(u);
   Power P;
-  try {
-    eq.initial_state(q, v, o.initial == InitialState::Static);
-    a = eq.accelerations(0.0, q.data(), v.data());
-    P = eq.residual(0.0, q.data(), v.data(), a.data(), r.data());
-  } catch (const std::exception& e) {
-    out.status = RunStatus::failed(at_start(e.what()));
-    return out;
-  }
-  ++st.residual_evals;
   double Wd = 0.0, Wi = 0.0;  // dissipated energy, input work
-  if (!q.allFinite() || !v.allFinite() || !a.allFinite()) {
-    out.status = RunStatus::failed("the initial state is not finite (check the inputs' values)");
-    return out;
-  }
-  {
+  if (resume) {
+    if (resume->q.size() != u || resume->v.size() != u || resume->a.size() != u)
+      throw std::invalid_argument("the state to resume from has " + std::to_string(resume->q.size()) +
+                                  " unknowns, the model " + std::to_string(u));
+    q = resume->q;
+    v = resume->v;
+    a = resume->a;
+    P = resume->power;
+    Wd = resume->dissipated;
+    Wi = resume->input_work;
+    st = resume->stats;
+    if (resume->next_output < 1 || resume->next_output > output_count(o) + 1 || !(resume->h > 0))
+      throw std::invalid_argument("the state to resume from does not fit the run's outputs (another t_end or output_dt?)");
+    out.t_reached = output_time(o, resume->next_output - 1);
+  } else {
+    try {
+      eq.initial_state(q, v, o.initial == InitialState::Static);
+      a = eq.accelerations(0.0, q.data(), v.data());
+      P = eq.residual(0.0, q.data(), v.data(), a.data(), r.data());
+    } catch (const std::exception& e) {
+      out.status = RunStatus::failed(at_start(e.what()));
+      return out;
+    }
+    ++st.residual_evals;
+    if (!q.allFinite() || !v.allFinite() || !a.allFinite()) {
+      out.status = RunStatus::failed("the initial state is not finite (check the inputs' values)");
+      return out;
+    }
     OutputSample s0;
     try {
       s0 = eq.sample(0.0, q.data(), v.data(), a.data(), 0.0, 0.0);
@@ -197,16 +212,17 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
     h = std::max(h, 1e-10 * o.t_end);
     if (o.fixed_step > 0) h = o.fixed_step;
   }
+  if (resume) h = resume->h;
 
   // Fixed steps cannot be cut: give the Newton iteration room to reach the (tight) tolerance.
   const int max_newton = o.fixed_step > 0 ? 60 : kMaxNewton;
-  double t = 0.0, err_prev = 1.0, eta = 1.0;
+  double t = resume ? resume->t : 0.0, err_prev = resume ? resume->err_prev : 1.0, eta = resume ? resume->eta : 1.0;
   bool last_rejected = false;
   bool nonfinite = false;  // a residual or an error estimate was NaN or inf since the last accepted step
   const std::vector<double> breaks = eq.breakpoints(o.t_end);
   size_t next_break = 0;
   const long n_out = output_count(o);
-  long k_out = 1, steps_this_output = 0, attempts_this_output = 0;
+  long k_out = resume ? resume->next_output : 1, steps_this_output = 0, attempts_this_output = 0;
   auto t_output = [&](long k) { return output_time(o, k); };
   auto fail = [&](const std::string& why) {
     char buf[200];
@@ -405,6 +421,26 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
       last_rejected = nonfinite = false;
       h = o.fixed_step > 0 ? o.fixed_step : h * fac;
       if (o.max_step > 0) h = std::min(h, o.max_step);
+      const bool saved = emit.checkpoint([&] {
+        IntegratorState x;
+        x.t = t;
+        x.h = h;
+        x.err_prev = err_prev;
+        x.eta = eta;
+        x.dissipated = Wd;
+        x.input_work = Wi;
+        x.power = P;
+        x.next_output = k_out;
+        x.stats = st;
+        x.q = q;
+        x.v = v;
+        x.a = a;
+        return x;
+      });
+      if (!saved) {
+        out.status = emit.failure();
+        return out;
+      }
     }
   } catch (const std::exception& e) {
     return fail(e.what());

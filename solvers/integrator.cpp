@@ -57,7 +57,23 @@ RunOutcome inverse_dynamics_only(EquationsOfMotion& eq, const IntegratorOptions&
 }  // namespace
 
 SampleEmitter::SampleEmitter(const SampleSink& sink, const RunControl& control)
-    : sink_(sink), control_(control), last_beat_(now_s()) {}
+    : sink_(sink), control_(control), last_beat_(now_s()), last_checkpoint_(last_beat_) {}
+
+bool SampleEmitter::checkpoint(const std::function<IntegratorState()>& st) {
+  if (failed()) return false;
+  if (!control_.checkpoint || !(control_.checkpoint_interval > 0)) return true;
+  const double now = now_s();
+  if (now - last_checkpoint_ < control_.checkpoint_interval) return true;
+  try {
+    control_.checkpoint(st());
+  } catch (const std::exception& e) {
+    error_ = e.what();
+  } catch (...) {
+    error_ = "the checkpoint threw an unknown exception";
+  }
+  last_checkpoint_ = now_s();  // (the interval counts from the end of the writing)
+  return !failed();
+}
 
 namespace {
 bool finite(const OutputSample& s) {
@@ -144,6 +160,8 @@ RunOutcome integrate(std::shared_ptr<const Model> model, std::vector<JointInput>
                        opts.kind == IntegratorKind::Bdf);  // IDA's solve needs K on its own
   SampleEmitter emit(sink, control);
   try {
+    if (control.resume && eq.unknowns() == 0)
+      throw std::invalid_argument("a run without unknowns (inverse dynamics) does not resume: run it again");
     if (eq.unknowns() == 0) return inverse_dynamics_only(eq, opts, emit);
     return opts.kind == IntegratorKind::Bdf ? integrate_bdf(eq, opts, emit) : integrate_esdirk(eq, opts, emit);
   } catch (const std::exception& e) {  // (the integrators report their own failures; this is what is left)

@@ -86,6 +86,24 @@ inline constexpr double kMaxOutputs = 1e8;
 
 using SampleSink = std::function<void(const OutputSample&)>;
 
+/// Everything the ESDIRK integrator carries from one step to the next, taken after an accepted step
+/// whose outputs have been delivered: resuming from it continues the run as if it had never stopped
+/// (bit for bit with the same thread team). BDF's is its state at an output (IDA's history is not
+/// kept). Written into results files as a checkpoint (studies/checkpoints.hpp).
+struct IntegratorState {
+  double t = 0.0, h = 0.0;        ///< time reached [s], next step size [s]
+  double err_prev = 1.0, eta = 1.0;  ///< step controller's last error, Newton's contraction estimate
+  double dissipated = 0.0, input_work = 0.0;  ///< the energy integrals at t [J]
+  Power power;                    ///< the power flows at t
+  long next_output = 0;           ///< index of the next output (output_time)
+  IntegratorStats stats;
+  VecX q, v, a;                   ///< the unknowns' coordinates, rates and accelerations at t
+  /// As doubles (a version number first), and back; unpack throws std::invalid_argument for a
+  /// vector that is not a state of `unknowns` unknowns (−1: of any number).
+  std::vector<double> pack() const;
+  static IntegratorState unpack(const std::vector<double>& x, int unknowns);
+};
+
 /// How the caller steers a run while it goes: a stop token polled at every step, and a heartbeat
 /// called from the integration loop at most every `heartbeat_interval` seconds of wall time (for
 /// progress, and for a caller that must poll something of its own, e.g. Python's signals). The
@@ -94,6 +112,15 @@ struct RunControl {
   StopToken stop;
   std::function<void(double t, long steps)> heartbeat;
   double heartbeat_interval = 0.2;  ///< [s]
+  /// Called on the calling thread with the integrator's state after an accepted step (BDF: after an
+  /// output) at most every `checkpoint_interval` seconds of wall time (0: never). If it throws, the
+  /// run fails with its message.
+  std::function<void(const IntegratorState&)> checkpoint;
+  double checkpoint_interval = 0.0;  ///< [s]
+  /// Start from this state instead of t = 0 (the outputs before state.next_output are not delivered
+  /// again): ESDIRK goes on bit for bit, BDF restarts IDA there (the same solution within the
+  /// tolerances). Checked against the model's unknowns.
+  const IntegratorState* resume = nullptr;
 };
 
 /// Integrates from t = 0 to t_end, calling `sink` at t = 0 and every output_dt (output_time).
@@ -143,6 +170,10 @@ class SampleEmitter {
   bool operator()(const OutputSample& s);
   /// Calls the heartbeat if its interval has passed. False if it threw.
   bool beat(double t, long steps);
+  /// Hands the state to the caller's checkpoint if its interval has passed (`st` is called only
+  /// then). False if it threw.
+  bool checkpoint(const std::function<IntegratorState()>& st);
+  const IntegratorState* resume() const { return control_.resume; }
   bool failed() const { return !error_.empty(); }
   /// The status of a run ended by the sink or heartbeat.
   RunStatus failure() const { return RunStatus::failed(error_); }
@@ -151,7 +182,7 @@ class SampleEmitter {
   const SampleSink& sink_;
   const RunControl& control_;
   std::string error_;
-  double last_beat_ = 0.0;
+  double last_beat_ = 0.0, last_checkpoint_ = 0.0;
 };
 
 }  // namespace rfem

@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <stdexcept>
 
 #include "rfem/core/positions.hpp"
+#include "rfem/studies/checkpoints.hpp"
 #include "rfem/solvers/modes.hpp"
 #include "rfem/solvers/statics.hpp"
 
@@ -328,6 +330,39 @@ std::vector<double> QuantityRecorder::values() const {
     out[k] = dynamic_value(q, times->second, s);
   }
   return out;
+}
+
+std::vector<double> QuantityRecorder::save() const {
+  std::vector<double> x = {static_cast<double>(series_.size())};
+  for (const auto& v : series_) put_block(x, v);
+  x.push_back(static_cast<double>(times_.size()));
+  for (const auto& [run, t] : times_) {
+    RunName r = RunName::Run;
+    parse(run, r);
+    x.push_back(static_cast<double>(static_cast<int>(r)));
+    put_block(x, t);
+  }
+  return x;
+}
+
+void QuantityRecorder::restore(const std::vector<double>& x) {
+  size_t i = 0;
+  const std::string why = "the checkpoint's quantity series are not of these quantities";
+  auto bad = [&] { return std::invalid_argument(why); };
+  auto block = [&] { return take_block(x, i, why); };
+  if (x.empty() || x[0] != static_cast<double>(series_.size())) throw bad();
+  i = 1;
+  for (auto& v : series_) v = block();
+  if (i >= x.size()) throw bad();
+  const double runs = x[i++];
+  times_.clear();
+  for (double k = 0; k < runs; ++k) {
+    if (i >= x.size()) throw bad();
+    const double r = x[i++];
+    if (!(r >= 0 && r <= static_cast<int>(RunName::Force))) throw bad();
+    const std::string run = to_string(static_cast<RunName>(static_cast<int>(r)));
+    times_[run] = block();
+  }
 }
 
 }  // namespace rfem

@@ -78,6 +78,10 @@ class QuantityRecorder : public RunObserver {
   void begin(const RunInfo& info) override;
   void sample(const OutputSample& s) override;
   std::vector<double> values() const;
+  // (its series so far go into a run's checkpoint: a resumed study evaluates the same values)
+  std::string state_key() const override { return "quantities"; }
+  std::vector<double> save() const override;
+  void restore(const std::vector<double>& x) override;
 
  private:
   std::vector<Quantity> qs_;

@@ -11,8 +11,10 @@ void Hdf5Recorder::begin(const RunInfo& info) {
   d.inputs = info.inputs;
   d.flexible_every = info.flexible_every;
   d.threads = info.threads;
-  run_ = file_.begin_run(info.name, info.model, d);
+  run_ = info.resume ? file_.resume_run(info.name, info.model, d, *info.resume) : file_.begin_run(info.name, info.model, d);
 }
+
+void Hdf5Recorder::checkpoint(const std::vector<double>& state) { run_->checkpoint(state); }
 
 void Hdf5Recorder::sample(const OutputSample& s) { run_->append(s); }
 
@@ -35,7 +37,7 @@ std::vector<std::string> write_views(const Case& cs, const Model& model, const s
 }
 
 FileDescription describe(const Case& cs, const std::string& command_line, const std::string& procedure, long n,
-                         long threads) {
+                         long threads, long n_option) {
   FileDescription d;
   d.command_line = command_line;
   d.case_path = cs.path;
@@ -45,6 +47,7 @@ FileDescription describe(const Case& cs, const std::string& command_line, const 
   d.procedure = procedure;
   d.n = n;
   d.threads = threads;
+  d.n_option = n_option;
   return d;
 }
 

@@ -16,6 +16,7 @@ class Hdf5Recorder : public RunObserver {
   void begin(const RunInfo& info) override;
   void sample(const OutputSample& s) override;
   void end(const RunResult& r) override;
+  void checkpoint(const std::vector<double>& state) override;
   /// Output steps written of the current (or last) run.
   long samples() const { return run_ ? run_->samples() : 0; }
 
@@ -31,8 +32,9 @@ std::vector<std::string> write_views(const Case& cs, const Model& model, const s
 
 /// The attributes that let a results file describe its study: the case as read and after its
 /// overrides, how the file was made, the procedure ("single", "paper", "refine"), n (−1: several),
-/// the threads.
+/// the threads; the n the runs were asked for (0: the case's own; −1 for a refinement), which lets
+/// `--resume` build the same model.
 FileDescription describe(const Case& cs, const std::string& command_line, const std::string& procedure, long n,
-                         long threads);
+                         long threads, long n_option = -1);
 
 }  // namespace rfem

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "rfem/core/positions.hpp"
+#include "rfem/studies/checkpoints.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/validity.hpp"
 
@@ -52,8 +53,19 @@ RunResult run_one(const std::string& name, std::shared_ptr<const Model> model, c
   for (const MountedLink& L : model->links) s.peaks.push_back({L.name});
   IntegratorOptions o = cs.sim.options;
   o.parallel.threads = rq.threads;
-  const RunInfo info{name, model, o, input_kinds(inputs), cs.sim.flexible_every, o.parallel.max_threads()};
+  const auto from = rq.resume.find(name);
+  const Checkpoint* checkpoint = from == rq.resume.end() ? nullptr : &from->second;
+  RunState resumed;
+  if (checkpoint) resumed = RunState::unpack(checkpoint->state, -1);
+  const RunInfo info{name, model, o, input_kinds(inputs), cs.sim.flexible_every, o.parallel.max_threads(), checkpoint};
   for (RunObserver* obs : rq.observers) obs->begin(info);
+  if (checkpoint)
+    for (RunObserver* obs : rq.observers)
+      if (const std::string key = obs->state_key(); !key.empty()) {
+        const std::vector<double>* x = resumed.find(key);
+        if (!x) throw std::invalid_argument("run " + name + ": its checkpoint holds no state of " + key);
+        obs->restore(*x);
+      }
   if (rq.keep_series) {
     s.series = std::make_shared<RunSeries>();
     s.series->layout = run_layout(*model, cs.sim.flexible_every);
@@ -91,18 +103,57 @@ RunResult run_one(const std::string& name, std::shared_ptr<const Model> model, c
     s.energy_scale = std::max({s.energy_scale, x.energy.kinetic, std::abs(x.energy.elastic), std::abs(x.input_work)});
     ++s.samples;
   };
+  // The run's own summary in a checkpoint, and back.
+  double wall_before = 0.0;
+  auto summary = [&](double wall) {
+    std::vector<double> x = {static_cast<double>(s.samples), wall, balance0, s.energy_drift, s.energy_scale,
+                             static_cast<double>(s.peaks.size())};
+    for (const LinkPeaks& pk : s.peaks) x.insert(x.end(), {pk.u1, pk.u2, pk.theta});
+    const std::vector<double> v = validity.save();
+    x.insert(x.end(), v.begin(), v.end());
+    return x;
+  };
+  if (checkpoint) {
+    const std::vector<double>& x = resumed.summary;
+    const size_t links = s.peaks.size();
+    if (x.size() < 6 + 3 * links || x[5] != static_cast<double>(links))
+      throw std::invalid_argument("run " + name + ": its checkpoint is not of this model");
+    s.samples = static_cast<long>(x[0]);
+    wall_before = x[1];
+    balance0 = x[2];
+    s.energy_drift = x[3];
+    s.energy_scale = x[4];
+    for (size_t l = 0; l < links; ++l) {
+      s.peaks[l].u1 = x[6 + 3 * l];
+      s.peaks[l].u2 = x[7 + 3 * l];
+      s.peaks[l].theta = x[8 + 3 * l];
+    }
+    validity.restore(std::vector<double>(x.begin() + static_cast<long>(6 + 3 * links), x.end()));
+    if (checkpoint->rows != s.samples) throw std::invalid_argument("run " + name + ": its checkpoint is damaged (rows)");
+  }
   RunControl control;
   control.stop = rq.stop;
+  control.resume = checkpoint ? &resumed.integrator : nullptr;
+  control.checkpoint_interval = rq.checkpoint_interval;
   control.heartbeat_interval = rq.progress_interval;
   if (rq.progress) control.heartbeat = [&](double t, long steps) { rq.progress({name, t, o.t_end, steps}); };
   const auto t0 = std::chrono::steady_clock::now();
+  control.checkpoint = [&](const IntegratorState& st) {
+    RunState x;
+    x.integrator = st;
+    x.summary = summary(wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    for (RunObserver* obs : rq.observers)
+      if (const std::string key = obs->state_key(); !key.empty()) x.add(key, obs->save());
+    const std::vector<double> packed = x.pack();
+    for (RunObserver* obs : rq.observers) obs->checkpoint(packed);
+  };
   RunOutcome r;
   try {
     r = integrate(model, inputs, o, sink, control);
   } catch (const std::exception& e) {  // (bad options or inputs): the run's record says why
     r.status = RunStatus::failed(e.what());
   }
-  s.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s.wall_s = wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   s.status = r.status;
   s.stats = r.stats;
   s.t_reached = r.t_reached;
@@ -132,7 +183,12 @@ std::vector<RunResult> run_case(const Case& cs, std::shared_ptr<const Model> mod
   for (RunName r : rq.runs)
     if (std::find(all.begin(), all.end(), r) == all.end())
       throw CaseError(cs.path + ": simulation.procedure: " + to_string(cs.sim.procedure) + " has no run '" + to_string(r) + "'");
-  auto wanted = [&](RunName r) { return rq.runs.empty() || std::find(rq.runs.begin(), rq.runs.end(), r) != rq.runs.end(); };
+  // Asked for, and not completed before (a resumed study).
+  auto wanted = [&](RunName r) {
+    const std::string full = rq.prefix + to_string(r);
+    return (rq.runs.empty() || std::find(rq.runs.begin(), rq.runs.end(), r) != rq.runs.end()) &&
+           std::find(rq.done.begin(), rq.done.end(), full) == rq.done.end();
+  };
   std::vector<RunResult> runs;
   auto go_on = [&] { return runs.empty() || (runs.back().completed() && !rq.stop.requested()); };
   if (cs.sim.procedure == Procedure::Paper) {
@@ -144,7 +200,7 @@ std::vector<RunResult> run_case(const Case& cs, std::shared_ptr<const Model> mod
     if (wanted(RunName::Kinematic) && go_on()) runs.push_back(run_one(rq.prefix + "kinematic", model, inputs, cs, rq));
     if (wanted(RunName::Force) && go_on())
       runs.push_back(run_one(rq.prefix + "force", model, rigid_torque_inputs(rigid, inputs), cs, rq));
-  } else {
+  } else if (wanted(RunName::Run)) {
     runs.push_back(run_one(rq.prefix + "run", model, inputs, cs, rq));
   }
   return runs;

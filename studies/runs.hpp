@@ -6,6 +6,7 @@
 // studies/recorders.hpp). A stop token ends a run cleanly within a step; progress goes to a
 // callback; warnings are returned, never printed.
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -70,6 +71,8 @@ struct RunInfo {
   std::vector<std::string> inputs;  ///< per joint: motion, torque or feedback
   int flexible_every = 0;
   long threads = 0;                 ///< the largest team the run may use
+  /// The checkpoint the run resumes from (its rows before it kept; null: from t = 0).
+  const Checkpoint* resume = nullptr;
 };
 
 /// Sees every run of a study as it goes. A throwing sample() ends that run as failed with the
@@ -80,6 +83,15 @@ class RunObserver {
   virtual void begin(const RunInfo&) {}
   virtual void sample(const OutputSample&) {}
   virtual void end(const RunResult&) {}
+  /// A checkpoint of the run (RunRequest::checkpoint_interval) after the samples so far: `state`
+  /// is everything a resumed run needs (studies/checkpoints.hpp); the observer that keeps the
+  /// results file stores it (Hdf5Recorder).
+  virtual void checkpoint(const std::vector<double>& /*state*/) {}
+  /// An observer that accumulates (over the study's runs) names its state here, gives it to every
+  /// checkpoint and gets it back when a run resumes; "" for none.
+  virtual std::string state_key() const { return {}; }
+  virtual std::vector<double> save() const { return {}; }
+  virtual void restore(const std::vector<double>& /*state*/) {}
 };
 
 /// Where a run is, for a progress display.
@@ -88,6 +100,10 @@ struct Progress {
   double t = 0, t_end = 0;
   long steps = 0;
 };
+
+/// The default wall time between checkpoints [s]: a killed run loses at most this much; writing
+/// the state (3 numbers per unknown) costs well under 1 % of it (bench/checkpoint_bench.py).
+inline constexpr double kCheckpointInterval = 5.0;
 
 struct RunRequest {
   int n = 0;                  ///< rfes in all links (0: the case's own discretisation)
@@ -102,6 +118,13 @@ struct RunRequest {
   double progress_interval = 0.2;
   std::vector<RunObserver*> observers;  ///< the caller keeps them alive for the call
   Warnings warn;
+  /// Wall time between a run's checkpoints [s] (0: none): written by the observers' checkpoint()
+  /// (a results file's run group), resumed from with `resume`.
+  double checkpoint_interval = kCheckpointInterval;
+  /// Continue a study (studies/resume.hpp): runs (by full name) that completed before and are not
+  /// run again, and the checkpoints the others resume from.
+  std::vector<std::string> done;
+  std::map<std::string, Checkpoint> resume;
 };
 
 /// Runs the case's procedure on its model with n rfes (CaseError for a case without

@@ -20,6 +20,7 @@
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/quantities.hpp"
 #include "rfem/studies/recorders.hpp"
+#include "rfem/studies/resume.hpp"
 #include "rfem/studies/runs.hpp"
 
 namespace rfem {
@@ -115,7 +116,7 @@ Sweep read_sweep(const std::string& path, const std::string& index) {
   const Reader r(path);
   r.check_keys(root, "", {"sweep", "parameters"});
   const toml::table& st = r.table(root, "", "sweep");
-  r.check_keys(st, "sweep", {"case", "set", "quantities", "combine", "output"});
+  r.check_keys(st, "sweep", {"case", "set", "quantities", "combine", "output", "checkpoint"});
   const std::string dir = fs::path(path).parent_path().string();
   const std::string given = r.string(st, "sweep", "case");
   s.case_path = given.empty() || given[0] == '/' || dir.empty() ? given : dir + "/" + given;
@@ -136,6 +137,9 @@ Sweep read_sweep(const std::string& path, const std::string& index) {
   const std::string combine = r.string(st, "sweep", "combine", std::string("grid"));
   if (combine != "grid" && combine != "zip") r.fail(st.get("combine"), "sweep.combine", "must be \"grid\" or \"zip\" (got \"" + combine + "\")");
   s.zip = combine == "zip";
+  s.checkpoint = r.number(st, "sweep", "checkpoint", kCheckpointInterval);
+  if (!(s.checkpoint >= 0.0))
+    r.fail(st.get("checkpoint"), "sweep.checkpoint", "must be 0 (none) or a positive number of seconds (got " + std::to_string(s.checkpoint) + ")");
   s.index = !index.empty() ? index : r.string(st, "sweep", "output", fs::path(path).stem().string() + ".h5");
   if (fs::path(s.index).extension() != ".h5") r.fail(st.get("output") ? st.get("output") : &st, "sweep.output", "the index must be an .h5 file (got '" + s.index + "')");
   s.directory = (fs::path(s.index).parent_path() / (fs::path(s.index).stem().string() + ".runs")).string();
@@ -213,21 +217,43 @@ SweepRow run_point(const Sweep& s, int k, const StopToken& stop, int threads, co
     std::vector<Quantity> qs;
     for (const std::string& q : s.quantities) qs.push_back(parse_quantity(c, q));
     fs::create_directories(s.directory);
-    const auto model = model_of(c, n);
-    ResultsWriter file(p.file, describe(c, "rfem sweep " + s.path + " (" + point_name(s, k) + ")", to_string(c.sim.procedure),
-                                        model->n(), threads));
-    Hdf5Recorder recorder(file);
     QuantityRecorder values(qs);
     RunRequest rq;
     rq.n = n;
     rq.threads = threads;
     rq.keep_series = false;
     rq.stop = stop;
-    rq.observers = {&recorder, &values};
     rq.warn = warn;
-    const std::vector<RunResult> runs = run_case(c, model, joint_inputs(c, warn), rq);
-    row.status = "completed";
+    rq.checkpoint_interval = s.checkpoint;
+    // A point whose run was interrupted or killed after a checkpoint goes on from it (same case);
+    // otherwise it runs from the start.
+    std::optional<ResumePlan> plan;
+    try {
+      if (fs::exists(p.file)) plan = plan_resume(p.file);
+    } catch (const std::exception&) {
+    }
+    if (plan && (plan->resume.empty() || plan->n != n || plan->cs.effective_text != c.effective_text)) plan.reset();
+    std::vector<RunResult> runs;
     row.wall_s = 0.0;
+    if (plan) {
+      rq.observers = {&values};
+      runs = resume_case(*plan, rq);
+      const ResultsReader in(p.file);  // the runs kept: their cost
+      for (const std::string& r : plan->done) {
+        row.wall_s += in.number(r, "wall_time_s", 0.0);
+        row.steps += static_cast<long>(in.number(r, "steps", 0.0));
+        row.residual_evals += static_cast<long>(in.number(r, "residual_evals", 0.0));
+      }
+    } else {
+      const auto model = model_of(c, n);
+      ResultsWriter file(p.file, describe(c, "rfem sweep " + s.path + " (" + point_name(s, k) + ")",
+                                          to_string(c.sim.procedure), model->n(), threads, n));
+      Hdf5Recorder recorder(file);
+      rq.observers = {&recorder, &values};
+      runs = run_case(c, model, joint_inputs(c, warn), rq);
+      file.close();
+    }
+    row.status = "completed";
     for (const RunResult& r : runs) {
       row.wall_s += r.wall_s;
       row.steps += r.stats.steps;
@@ -238,9 +264,8 @@ SweepRow run_point(const Sweep& s, int k, const StopToken& stop, int threads, co
         break;
       }
     }
-    if (stop.requested()) {  // not finished: runs again next time (no sweep_status in its file)
+    if (stop.requested()) {  // not finished: goes on next time (no sweep_status in its file)
       row.status = "interrupted";
-      file.close();
       return row;
     }
     if (row.completed()) {
@@ -248,6 +273,7 @@ SweepRow run_point(const Sweep& s, int k, const StopToken& stop, int threads, co
       for (size_t q = 0; q < qs.size(); ++q)
         if (!qs[q].dynamic()) row.values[q] = evaluate_quantity(c, n, qs[q]);
     }
+    ResultsWriter file(p.file, Reopen{});
     if (!s.quantities.empty()) file.write_table("sweep_values", {1, static_cast<long>(row.values.size()), row.values}, s.quantities,
                                                 std::vector<std::string>(s.quantities.size(), ""), "the sweep's quantities of this run");
     file.write_table("sweep_statistics", {1, 4, {row.wall_s, row.t_reached, static_cast<double>(row.steps), static_cast<double>(row.residual_evals)}},

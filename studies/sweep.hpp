@@ -37,6 +37,7 @@ struct Sweep {
   bool zip = false;                ///< points: parameters zipped (else every combination)
   std::string index;               ///< the index file
   std::string directory;           ///< the run files' directory
+  double checkpoint = 0.0;         ///< wall time between a run's checkpoints [s] ([sweep] checkpoint, 0: none)
   std::vector<SweepPoint> points;
 };
 

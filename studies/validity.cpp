@@ -1,5 +1,7 @@
 #include "rfem/studies/validity.hpp"
 
+#include <stdexcept>
+
 #include <fmt/core.h>
 
 #include <cmath>
@@ -83,6 +85,33 @@ std::vector<std::string> ValidityMonitor::warnings(const std::string& context) c
         rev ? "N m" : "N");
   }
   return out;
+}
+
+std::vector<double> ValidityMonitor::save() const {
+  std::vector<double> x;
+  for (const Link& L : links_) x.insert(x.end(), {L.peak, L.peak_t, L.first_t, double(L.peak_rfe), L.exceeded ? 1.0 : 0.0});
+  for (const auto* v : {&range_, &speed_, &effort_})
+    for (const Excess& e : *v) x.insert(x.end(), {e.peak, e.peak_t, e.first_t});
+  return x;
+}
+
+void ValidityMonitor::restore(const std::vector<double>& x) {
+  if (x.size() != 5 * links_.size() + 9 * range_.size())
+    throw std::invalid_argument("the checkpoint's validity state is not of this model");
+  size_t i = 0;
+  for (Link& L : links_) {
+    L.peak = x[i++];
+    L.peak_t = x[i++];
+    L.first_t = x[i++];
+    L.peak_rfe = static_cast<int>(x[i++]);
+    L.exceeded = x[i++] != 0.0;
+  }
+  for (auto* v : {&range_, &speed_, &effort_})
+    for (Excess& e : *v) {
+      e.peak = x[i++];
+      e.peak_t = x[i++];
+      e.first_t = x[i++];
+    }
 }
 
 }  // namespace rfem

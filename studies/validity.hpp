@@ -26,6 +26,10 @@ class ValidityMonitor {
   /// One warning per link whose rfes turned beyond kSmallRotation ("" context: "the solution"),
   /// and per joint and limit its solution exceeded.
   std::vector<std::string> warnings(const std::string& context) const;
+  /// What it has seen, as doubles (a run's checkpoint), and back; restore throws
+  /// std::invalid_argument for a state of another model.
+  std::vector<double> save() const;
+  void restore(const std::vector<double>& x);
 
  private:
   struct Link {

@@ -2,8 +2,8 @@
 # rfem sweep: a 6-point sweep of Kane's spin-up over n and T gives the same table run one at a
 # time, two at a time and (when built with MPI: $2 = 1) across 3 MPI ranks; its peaks converge with
 # observed order 2 ± 0.3 in n at each T; a sweep killed with SIGKILL, or stopped by SIGINT (exit
-# 130), leaves a valid index and a rerun redoes only what did not finish, ending with the
-# uninterrupted table; bad sweep files give one line and exit 2; rfem plot draws the index.
+# 130), leaves a valid index and a rerun redoes only what did not finish (the interrupted point
+# from its checkpoint), ending with the uninterrupted table bit for bit; bad sweep files give one line and exit 2; rfem plot draws the index.
 set -euo pipefail
 source "$(dirname "$0")/cli_test_env.sh"
 mpi=${2:-0}
@@ -56,6 +56,7 @@ cat > k.toml <<TOML
 case = "$src/cases/kane_spinup.toml"
 quantities = ["peak:u1"]
 set = ["simulation.t_end=4"]
+checkpoint = 0.1
 [parameters]
 n = [$kill_n]
 "joints.0.input.T" = [10.0, 11.0, 12.0, 13.0]
@@ -66,6 +67,7 @@ for sig in KILL INT; do
   "$rfem" sweep k.toml --jobs 1 -q 2>/dev/null &
   pid=$!
   for i in $(seq 1 6000); do [ "$(completed k.h5)" -ge 1 ] && break; sleep 0.05; done
+  sleep 0.4  # (the next point under way, past a checkpoint)
   kill -$sig "$pid"
   set +e
   wait "$pid"
@@ -79,7 +81,9 @@ for sig in KILL INT; do
   "$rfem" sweep k.toml --jobs 1 -q 2>/dev/null
   [ "$(stat -c %Y.%N k.runs/run0000.h5 2>/dev/null || stat -c %Y k.runs/run0000.h5)" = "$first" ] || { echo "FAIL: SIG$sig: a finished point ran again"; exit 1; }
   [ "$(completed k.h5)" = 4 ] || { echo "FAIL: SIG$sig: the rerun did not finish the sweep"; exit 1; }
-  echo "ok   SIG$sig after $done_before of 4 points: exit $code, the rerun ran the other $((4 - done_before))"
+  resumed=$(/usr/bin/python3 -c "import h5py; print(h5py.File('k.runs/run000$done_before.h5')['run'].attrs.get('resumed_from_row', 0))")
+  [ "$resumed" -gt 0 ] || { echo "FAIL: SIG$sig: the interrupted point did not go on from its checkpoint"; exit 1; }
+  echo "ok   SIG$sig after $done_before of 4 points: exit $code, the rerun ran the other $((4 - done_before)), the interrupted one from its checkpoint (output $resumed)"
 done
 if [ "$mpi" = 1 ]; then  # a worker rank killed: OpenMPI ends the job; the rerun redoes what did not finish
   rm -rf k.h5 k.runs

@@ -106,6 +106,7 @@ class Runs(list):
         return all(r.completed for r in self)
 
     warnings = ()
+    kept = ()
 
 
 def _raise(error, result):
@@ -116,7 +117,8 @@ def _raise(error, result):
     raise error
 
 
-def run(case, n=None, output=None, runs=None, threads=0, keep_series=True, progress=None):
+def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, progress=None, resume=None,
+        checkpoint=_rfem.CHECKPOINT_INTERVAL):
     """Runs the case's [simulation] by its procedure (single: "run"; paper: "rigid", "kinematic",
     "force") and returns the Runs.
 
@@ -128,11 +130,27 @@ def run(case, n=None, output=None, runs=None, threads=0, keep_series=True, progr
     threads:     kernel threads (0: each run times one thread against all)
     keep_series: keep every series in memory (Run.table, Run.column); False keeps only summaries
     progress:    called about ten times a second with {"run", "t", "t_end", "steps"}
+    resume:      a results file an interrupted or killed run left (rfem.run with output=, or rfem run):
+                 continue its runs from their last checkpoints, as `rfem run --resume` (no case, n,
+                 output or runs: the file has them); returns the runs run now (.kept: the names of
+                 those that had completed), their series read back whole from the file
+    checkpoint:  seconds of wall time between checkpoints written into `output` (0: none)
 
     A run that fails has status "failed: …" (the outputs before kept); Ctrl-C raises
     RunInterrupted with the runs so far in .result."""
+    if resume is not None:
+        if case is not None or n is not None or output is not None or runs is not None:
+            raise ValueError("rfem.run(resume=...) takes no case, n, output or runs: the results file has them")
+        out, error, warnings, kept = _rfem._resume(_os.fspath(resume), threads, keep_series, progress, checkpoint)
+        result = Runs(out)
+        result.warnings = warnings
+        result.kept = kept
+        _raise(error, result)
+        return result
+    if case is None:
+        raise ValueError("rfem.run needs a case (or resume=RESULTS.h5)")
     out, error, warnings = _rfem._run(case, n or 0, _os.fspath(output) if output else "", list(runs or []),
-                                      threads, keep_series, progress)
+                                      threads, keep_series, progress, checkpoint)
     result = Runs(out)
     result.warnings = warnings
     _raise(error, result)

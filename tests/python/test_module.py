@@ -128,7 +128,7 @@ def test_ctrl_c_keeps_the_results_and_the_next_run_goes_on(tmp_path):
             os.kill(os.getpid(), signal.SIGINT)
 
     with pytest.raises(rfem.RunInterrupted) as e:
-        rfem.run(case, n=60, threads=1, output=tmp_path / "i.h5", progress=progress)
+        rfem.run(case, n=60, threads=1, output=tmp_path / "i.h5", progress=progress, checkpoint=1e-9)
     assert isinstance(e.value, KeyboardInterrupt)
     runs = e.value.result
     r = runs[0]
@@ -146,6 +146,18 @@ def test_ctrl_c_keeps_the_results_and_the_next_run_goes_on(tmp_path):
     assert again.completed
     k = int(np.searchsorted(t, 1.0 + 1e-9))
     np.testing.assert_array_equal(again.table("joint_tau")[:k], r.table("joint_tau")[:k])
+    # Resumed from its last checkpoint (one after every step), the run ends as the uninterrupted
+    # one, bit for bit (ESDIRK, one thread), its whole series read back from the file.
+    with pytest.raises(ValueError, match="takes no case"):
+        rfem.run(case, resume=tmp_path / "i.h5")
+    resumed = rfem.run(resume=tmp_path / "i.h5", threads=1)
+    assert list(resumed.kept) == [] and resumed[0].completed
+    whole = rfem.run(case, n=60, threads=1)[0]
+    for name in ("time", "joint_tau", "joint_q", "tip_deflection", "energy"):
+        np.testing.assert_array_equal(resumed[0].table(name), whole.table(name))
+    assert resumed[0].stats["steps"] == whole.stats["steps"]
+    with pytest.raises(rfem.CaseError, match="no such results file"):
+        rfem.run(resume=tmp_path / "missing.h5")
 
 
 def test_arrays_outlive_their_run():

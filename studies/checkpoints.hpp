@@ -1,0 +1,30 @@
+#pragma once
+// What a run's checkpoint holds (results/writer.hpp stores it in the run's group): the integrator's
+// state, the run's own summary so far (peaks, energy balance, validity, outputs, wall time) and the
+// state of every observer that accumulates over a study (by its state_key), packed as doubles.
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "rfem/solvers/integrator.hpp"
+
+namespace rfem {
+
+/// A packed state's blocks: their length, then their values.
+void put_block(std::vector<double>& x, const std::vector<double>& block);
+/// The block at x[i] (i moves past it); std::invalid_argument(`what`) if x ends before it does.
+std::vector<double> take_block(const std::vector<double>& x, size_t& i, const std::string& what);
+
+struct RunState {
+  IntegratorState integrator;
+  std::vector<double> summary;
+  std::vector<std::pair<double, std::vector<double>>> observers;  ///< (key's hash, state)
+  /// The state saved under `key`, or null.
+  const std::vector<double>* find(const std::string& key) const;
+  void add(const std::string& key, std::vector<double> state);
+  std::vector<double> pack() const;
+  /// Throws std::invalid_argument naming what does not fit (another version, another model).
+  static RunState unpack(const std::vector<double>& x, int unknowns);
+};
+
+}  // namespace rfem

@@ -1,0 +1,149 @@
+// Resuming runs from their checkpoints (studies/resume.hpp): the paper's procedure stopped in its
+// kinematic run and resumed from the results file gives every series and quantity of the
+// uninterrupted procedure bit for bit (ESDIRK, one thread: the same arithmetic in the same order);
+// the integrator's state survives packing; a checkpoint of another model is refused.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "rfem/results/writer.hpp"
+#include "rfem/studies/inputs.hpp"
+#include "rfem/studies/quantities.hpp"
+#include "rfem/studies/recorders.hpp"
+#include "rfem/studies/resume.hpp"
+#include "tests/test_models.hpp"
+
+using namespace rfem;
+
+namespace {
+
+constexpr int kN = 12;
+Case paper() { return read_case(test::source_path("cases/paper_deployment.toml"), {"simulation.t_end=3.0"}); }
+
+// Requests a stop at the k-th sample of run `run`.
+class StopAt : public RunObserver {
+ public:
+  StopAt(StopToken stop, std::string run, long k) : stop_(std::move(stop)), run_(std::move(run)), k_(k) {}
+  void begin(const RunInfo& info) override { current_ = info.name, seen_ = 0; }
+  void sample(const OutputSample&) override {
+    if (current_ == run_ && ++seen_ == k_) stop_.request();
+  }
+
+ private:
+  StopToken stop_;
+  std::string run_, current_;
+  long k_, seen_ = 0;
+};
+
+std::vector<Quantity> quantities(const Case& cs) {
+  return {parse_quantity(cs, "kinematic/peak:u1"), parse_quantity(cs, "force/peak:u2"), parse_quantity(cs, "rigid/tau3@2")};
+}
+
+std::string temp_file(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("rfem_test_resume_" + std::to_string(::getpid()) + "_" + name)).string();
+}
+
+}  // namespace
+
+TEST(Resume, PaperProcedureStoppedInItsKinematicRunEndsBitForBitAsUninterrupted) {
+  const Case cs = paper();
+  RunRequest whole;
+  whole.n = kN;
+  whole.threads = 1;
+  QuantityRecorder q_whole(quantities(cs));
+  whole.observers = {&q_whole};
+  const std::vector<RunResult> ref = run_case(cs, whole);
+  ASSERT_EQ(ref.size(), 3u);
+  ASSERT_TRUE(ref.back().completed());
+
+  // Stopped at the 120th output of the kinematic run, a checkpoint after every step.
+  const std::string path = temp_file("paper.h5");
+  const auto model = model_of(cs, kN);
+  QuantityRecorder q_first(quantities(cs));
+  {
+    ResultsWriter file(path, describe(cs, "test_resume", "paper", model->n(), 1, kN));
+    Hdf5Recorder recorder(file);
+    RunRequest rq;
+    rq.n = kN;
+    rq.threads = 1;
+    rq.keep_series = false;
+    rq.checkpoint_interval = 1e-9;
+    StopAt stop(rq.stop, "kinematic", 120);
+    rq.observers = {&recorder, &q_first, &stop};
+    const std::vector<RunResult> runs = run_case(cs, model, joint_inputs(cs, {}), rq);
+    ASSERT_EQ(runs.size(), 2u);
+    EXPECT_EQ(runs.back().status.kind, RunStatus::Kind::Interrupted);
+    file.close();
+  }
+  const ResumePlan plan = plan_resume(path);
+  EXPECT_EQ(plan.n, kN);
+  EXPECT_EQ(plan.done, std::vector<std::string>{"rigid"});
+  ASSERT_EQ(plan.resume.count("kinematic"), 1u);
+  EXPECT_EQ(plan.resume.at("kinematic").rows, 120);
+  EXPECT_FALSE(plan.finished());
+
+  RunRequest rq;
+  rq.threads = 1;
+  QuantityRecorder q_resumed(quantities(cs));  // (its series of the rigid run come from the checkpoint)
+  rq.observers = {&q_resumed};
+  const std::vector<RunResult> rest = resume_case(plan, rq);
+  ASSERT_EQ(rest.size(), 2u);
+  for (size_t r = 0; r < 2; ++r) {
+    const RunResult& a = ref[r + 1];
+    const RunResult& b = rest[r];
+    ASSERT_EQ(a.name, b.name);
+    ASSERT_TRUE(b.completed()) << b.status.to_string();
+    EXPECT_EQ(a.stats.steps, b.stats.steps) << a.name;
+    EXPECT_EQ(a.stats.residual_evals, b.stats.residual_evals) << a.name;
+    EXPECT_EQ(a.samples, b.samples) << a.name;
+    EXPECT_EQ(a.peaks[0].u1, b.peaks[0].u1) << a.name;
+    EXPECT_EQ(a.energy_drift, b.energy_drift) << a.name;
+    for (const std::string& name : a.series->names()) {
+      const Table x = a.series->table(name), y = b.series->table(name);
+      EXPECT_EQ(x.rows, y.rows) << a.name << "/" << name;
+      EXPECT_TRUE(x.data == y.data) << a.name << "/" << name << " differs";
+    }
+  }
+  const std::vector<double> v0 = q_whole.values(), v1 = q_resumed.values();
+  ASSERT_EQ(v0.size(), 3u);
+  for (size_t k = 0; k < v0.size(); ++k) {
+    EXPECT_TRUE(std::isfinite(v0[k]));
+    EXPECT_EQ(v0[k], v1[k]) << "quantity " << k;
+  }
+  EXPECT_TRUE(plan_resume(path).finished());
+  EXPECT_TRUE(resume_case(plan_resume(path), rq).empty());
+
+  // The same file with another model: its series do not fit, nothing is run.
+  ResumePlan other = plan_resume(path);
+  other.n = 2 * kN;
+  other.done.clear();
+  other.resume.emplace("rigid", Checkpoint{});
+  EXPECT_THROW(resume_case(other, RunRequest{}), std::exception);
+  std::filesystem::remove(path);
+}
+
+TEST(Resume, IntegratorStateRoundTripsAndRefusesAnotherModel) {
+  IntegratorState s;
+  s.t = 1.25;
+  s.h = 3e-3;
+  s.err_prev = 0.4;
+  s.eta = 0.01;
+  s.dissipated = 0.5;
+  s.input_work = 2.5;
+  s.power = {0.1, -0.2};
+  s.next_output = 7;
+  s.stats.steps = 123456789012;
+  s.stats.newton_fails = 3;
+  s.stats.last_step = 1e-3;
+  s.q = VecX::LinSpaced(5, -1, 1);
+  s.v = VecX::Constant(5, M_PI);
+  s.a = VecX::Constant(5, -1e300);
+  const IntegratorState r = IntegratorState::unpack(s.pack(), 5);
+  EXPECT_EQ(r.pack(), s.pack());
+  EXPECT_EQ(r.stats.steps, 123456789012);
+  EXPECT_EQ(r.next_output, 7);
+  EXPECT_THROW(IntegratorState::unpack(s.pack(), 6), std::invalid_argument);
+  std::vector<double> cut = s.pack();
+  cut.pop_back();
+  EXPECT_THROW(IntegratorState::unpack(cut, 5), std::invalid_argument);
+}
