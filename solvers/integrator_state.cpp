@@ -8,7 +8,7 @@ namespace rfem {
 
 namespace {
 constexpr double kVersion = 1.0;
-constexpr int kScalars = 16;  // version … last_step below
+constexpr int kScalars = 16;  // version … error_test_fails below; then last_step and the unknowns
 }  // namespace
 
 std::vector<double> IntegratorState::pack() const {
