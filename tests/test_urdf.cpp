@@ -58,8 +58,11 @@ TEST(Urdf, BuildsTheJointsFramesAndBodiesOfItsTwin) {
   EXPECT_LE((u.links[0].on.X - t.links[0].on.X).cwiseAbs().maxCoeff(), 1e-15);
   // Every URDF link is a frame; the root is the ground.
   ASSERT_EQ(u.frames.size(), 5u);  // base_link, turret, upper_arm, forearm, tool0
-  for (const BodyFrame& f : u.frames)
-    if (f.name == "base_link") EXPECT_EQ(f.joint, -1);
+  for (const BodyFrame& f : u.frames) {
+    if (f.name == "base_link") {
+      EXPECT_EQ(f.joint, -1);
+    }
+  }
 }
 
 TEST(Urdf, RunsLikeItsTwin) {
