@@ -5,6 +5,7 @@
 // gravity torques the held arm needs, from its mass distribution alone.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -58,11 +59,9 @@ TEST(Urdf, BuildsTheJointsFramesAndBodiesOfItsTwin) {
   EXPECT_LE((u.links[0].on.X - t.links[0].on.X).cwiseAbs().maxCoeff(), 1e-15);
   // Every URDF link is a frame; the root is the ground.
   ASSERT_EQ(u.frames.size(), 5u);  // base_link, turret, upper_arm, forearm, tool0
-  for (const BodyFrame& f : u.frames) {
-    if (f.name == "base_link") {
-      EXPECT_EQ(f.joint, -1);
-    }
-  }
+  const auto root = std::find_if(u.frames.begin(), u.frames.end(), [](const BodyFrame& f) { return f.name == "base_link"; });
+  ASSERT_NE(root, u.frames.end());
+  EXPECT_EQ(root->joint, -1);
 }
 
 TEST(Urdf, RunsLikeItsTwin) {
