@@ -45,14 +45,17 @@ void rfe_inertia(const Rfe& rfe, const LinkFrame& bk, const DeformationTransform
   const Vec3 wr = R0 * wrel;
   const Vec3 w = bk.w + wr;
   const Vec3 alpha = bk.wd + bk.w.cross(wr) + R0 * wdrel;
+  // Euler's equations in the rfe's axes (Rw its rotation in the base frame, Ic its central inertia
+  // there): τ = Rw (Ic α' + ω' × Ic ω') with α' = Rwᵀ α, ω' = Rwᵀ ω — no rotated inertia tensor.
   const Mat3 J = rfe.H.topLeftCorner<3, 3>();
-  const Mat3 Rw = R0 * d.D.topLeftCorner<3, 3>();
-  const Mat3 I = Rw * (J.trace() * Mat3::Identity() - J) * Rw.transpose();
-  const Vec3 tau = I * alpha + w.cross(I * w);
+  const Mat3 R = d.D.topLeftCorner<3, 3>(), Rw = R0 * R;
+  const Mat3 Ic = J.trace() * Mat3::Identity() - J;
+  const Vec3 wb = Rw.transpose() * w, Iw = Ic * wb;
+  const Vec3 taur = R * (Ic * (Rw.transpose() * alpha) + wb.cross(Iw));  // τ in {r} axes
+  const Vec3 tau = R0 * taur;
   f = rfe.mass * ac;
   n = p.cross(f) + tau;
   eps.head<3>() = R0.transpose() * f;
-  const Vec3 taur = R0.transpose() * tau;
   for (int k = 0; k < 3; ++k) eps[3 + k] = d.axis[k].dot(taur);
 }
 

@@ -46,21 +46,32 @@ void sde_forces(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const
 
 void sde_forces(const Sde& e, const Vec3& cl, const Vec3& cr, double beta, const Vec6& ql, const Vec6& vl,
                 const Vec6& qp, const Vec6& vp, const RfeRotation& rl, const RfeRotation& rp, SdeResult& out) {
-  Vec3 dx;
-  Eigen::Matrix<double, 3, 12> J;
-  displacement(e, cl, cr, ql, qp, rl, rp, dx, J);
+  // displacement()'s J written by its blocks (±I for the translations, Jl, Jr for the rotations): this
+  // runs for every sde in every residual, and most of J is zeros and identities.
   const bool has_left = e.left >= 0;
-  const Vec3 dphi = qp.tail<3>() - (has_left ? ql.tail<3>() : Vec3::Zero().eval());
-  Vec12 qdot;
-  qdot << (has_left ? vl : Vec6::Zero().eval()), vp;
-  const Vec3 dx_dot = J * qdot;
-  const Vec3 dphi_dot = qdot.segment<3>(9) - qdot.segment<3>(3);
+  Mat3 Jl, Jr;
+  for (int a = 0; a < 3; ++a) Jr.col(a) = rp.dR[a] * e.eta_right;
+  const Vec3 pr = cr + rp.R * e.eta_right + qp.head<3>();
+  Vec3 pl = cl + rl.R * e.eta_left, dx_dot = vp.head<3>() + Jr * vp.tail<3>();
+  Vec3 dphi = qp.tail<3>(), dphi_dot = vp.tail<3>();
+  if (has_left) {
+    for (int a = 0; a < 3; ++a) Jl.col(a) = rl.dR[a] * e.eta_left;
+    pl += ql.head<3>();
+    dx_dot -= vl.head<3>() + Jl * vl.tail<3>();
+    dphi -= ql.tail<3>();
+    dphi_dot -= vl.tail<3>();
+  }
+  const Vec3 dx = pr - pl;
   const Vec3 lam = e.c.cwiseProduct(dx + beta * dx_dot);     // spring + damper force
   const Vec3 mu = e.k.cwiseProduct(dphi + beta * dphi_dot);  // spring + damper moment
-  out.f = J.transpose() * lam;
-  out.f.segment<3>(3) -= mu;
-  out.f.segment<3>(9) += mu;
-  if (!has_left) out.f.head<6>().setZero();
+  out.f.segment<3>(6) = lam;
+  out.f.segment<3>(9) = Jr.transpose() * lam + mu;
+  if (has_left) {
+    out.f.head<3>() = -lam;
+    out.f.segment<3>(3) = -(Jl.transpose() * lam) - mu;
+  } else {
+    out.f.head<6>().setZero();
+  }
   out.V = 0.5 * dx.dot(e.c.cwiseProduct(dx)) + 0.5 * dphi.dot(e.k.cwiseProduct(dphi));
   out.P_d = beta * (dx_dot.dot(e.c.cwiseProduct(dx_dot)) + dphi_dot.dot(e.k.cwiseProduct(dphi_dot)));
 }

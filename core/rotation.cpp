@@ -25,47 +25,62 @@ Mat3 rot_z(double a) {
 Mat3 rot_rpy(const Vec3& rpy) { return rot_z(rpy[2]) * rot_y(rpy[1]) * rot_x(rpy[0]); }
 
 namespace {
-// First and second derivatives of the elementary rotations, written out (no generator products).
-Mat3 d_rot_x(double c, double s) { Mat3 R; R << 0, 0, 0, 0, -s, -c, 0, c, -s; return R; }
-Mat3 d_rot_y(double c, double s) { Mat3 R; R << -s, 0, c, 0, 0, 0, -c, 0, -s; return R; }
-Mat3 d_rot_z(double c, double s) { Mat3 R; R << -s, -c, 0, c, -s, 0, 0, 0, 0; return R; }
-Mat3 dd_rot_x(double c, double s) { Mat3 R; R << 0, 0, 0, 0, -c, s, 0, -s, -c; return R; }
-Mat3 dd_rot_y(double c, double s) { Mat3 R; R << -c, 0, -s, 0, 0, 0, s, 0, -c; return R; }
-Mat3 dd_rot_z(double c, double s) { Mat3 R; R << -c, s, 0, -s, -c, 0, 0, 0, 0; return R; }
+// [a×] M, column by column.
+Mat3 cross_cols(const Vec3& a, const Mat3& M) {
+  Mat3 r;
+  for (int j = 0; j < 3; ++j) r.col(j) = a.cross(M.col(j));
+  return r;
+}
+// [e_y×] M, the column-wise cross product with the y axis: (x, y, z) ↦ (z, 0, −x).
+Mat3 cross_y(const Mat3& M) {
+  Mat3 r;
+  r.row(0) = M.row(2);
+  r.row(1).setZero();
+  r.row(2) = -M.row(0);
+  return r;
+}
 }  // namespace
 
+// With A = Ry Rz and g_a the rotation axes (∂R/∂φ_a = [g_a×] R: g_1 = R e_x, g_2 = e_y, g_3 = Ry e_z),
+// every derivative is a column-wise cross product — no 3×3 products (this kernel runs once per rfe in
+// every residual):
+//   ∂R/∂φ1 = A ∂Rx = [0, R e_z, −R e_y],   ∂²R/∂φ1² = −[0, R e_y, R e_z],
+//   ∂²R/∂φ2∂φ_a = [e_y×] ∂R/∂φ_a (φ2 outermost),   ∂²R/∂φ3∂φ1 = [g_3×] ∂R/∂φ1,   ∂²R/∂φ3² = [g_3×]² R.
 void deformation_transform(const Vec6& q, DeformationTransform& out, bool second) {
   const double c1 = std::cos(q[3]), s1 = std::sin(q[3]), c2 = std::cos(q[4]), s2 = std::sin(q[4]);
   const double c3 = std::cos(q[5]), s3 = std::sin(q[5]);
-  Mat3 Rx, Ry, Rz;
-  Rx << 1, 0, 0, 0, c1, -s1, 0, s1, c1;
-  Ry << c2, 0, s2, 0, 1, 0, -s2, 0, c2;
-  Rz << c3, -s3, 0, s3, c3, 0, 0, 0, 1;
-  const Mat3 dRx = d_rot_x(c1, s1), dRy = d_rot_y(c2, s2), dRz = d_rot_z(c3, s3);
   // R = Ry(φ2) Rz(φ3) Rx(φ1): torsion innermost, about the rfe's own axis.
-  const Mat3 RyRz = Ry * Rz, RzRx = Rz * Rx;
-  out.D = homogeneous(RyRz * Rx, q.head<3>());
+  const Vec3 A0(c2 * c3, s3, -s2 * c3), A1(-c2 * s3, c3, s2 * s3), A2(s2, 0.0, c2);
+  Mat3 R;
+  R.col(0) = A0;
+  R.col(1) = c1 * A1 + s1 * A2;
+  R.col(2) = c1 * A2 - s1 * A1;
+  out.D = homogeneous(R, q.head<3>());
+  Mat3& dR0 = out.dR[0];
+  dR0.col(0).setZero();
+  dR0.col(1) = R.col(2);
+  dR0.col(2) = -R.col(1);
+  out.dR[1] = cross_y(R);
+  out.dR[2] = cross_cols(A2, R);
   for (int j = 0; j < 3; ++j) {
     out.dD[j].setZero();
     out.dD[j](j, 3) = 1.0;
+    out.dD[3 + j].leftCols<3>() = out.dR[j];
+    out.dD[3 + j].col(3).setZero();
   }
-  out.dR[0] = RyRz * dRx;
-  out.dR[1] = dRy * RzRx;
-  out.dR[2] = Ry * (dRz * Rx);
-  for (int a = 0; a < 3; ++a) {
-    out.dD[3 + a].setZero();
-    out.dD[3 + a].leftCols<3>() = out.dR[a];
-  }
-  out.axis[0] = RyRz.col(0);
+  out.axis[0] = A0;
   out.axis[1] = Vec3::UnitY();
-  out.axis[2] = Ry.col(2);
+  out.axis[2] = A2;
   if (!second) return;
-  out.ddR[0][0] = RyRz * dd_rot_x(c1, s1);
-  out.ddR[1][1] = dd_rot_y(c2, s2) * RzRx;
-  out.ddR[2][2] = Ry * (dd_rot_z(c3, s3) * Rx);
-  out.ddR[0][1] = out.ddR[1][0] = dRy * (Rz * dRx);
-  out.ddR[0][2] = out.ddR[2][0] = Ry * (dRz * dRx);
-  out.ddR[1][2] = out.ddR[2][1] = dRy * (dRz * Rx);
+  Mat3& dd00 = out.ddR[0][0];
+  dd00.col(0).setZero();
+  dd00.col(1) = -R.col(1);
+  dd00.col(2) = -R.col(2);
+  out.ddR[1][1] = cross_y(out.dR[1]);
+  out.ddR[2][2] = cross_cols(A2, out.dR[2]);
+  out.ddR[0][1] = out.ddR[1][0] = cross_y(dR0);
+  out.ddR[0][2] = out.ddR[2][0] = cross_cols(A2, dR0);
+  out.ddR[1][2] = out.ddR[2][1] = cross_y(out.dR[2]);
 }
 
 RfeRotation rfe_rotation(const DeformationTransform& d) { return {d.D.topLeftCorner<3, 3>(), d.dR}; }

@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include <cmath>
 #include <stdexcept>
 #include <type_traits>
 
@@ -69,6 +70,42 @@ template <int W>
 using BorderW = Eigen::Map<BorderMatrix<W>>;
 template <int W>
 using CBorderW = Eigen::Map<const BorderMatrix<W>>;
+
+// The 6×6 factors are kept as L with its diagonal inverted (row-major), so the substitutions below
+// multiply where Eigen's general triangular solvers would divide, and unroll for fixed sizes.
+// Lower Cholesky factor of the symmetric A into L (diagonal inverted); false unless positive definite.
+bool cholesky6(const Mat6& A, double* L) {
+  for (int j = 0; j < 6; ++j) {
+    double d = A(j, j);
+    for (int k = 0; k < j; ++k) d -= L[6 * j + k] * L[6 * j + k];
+    if (!(d > 0.0)) return false;  // also NaN
+    const double inv = 1.0 / std::sqrt(d);
+    L[7 * j] = inv;
+    for (int i = j + 1; i < 6; ++i) {
+      double a = A(i, j);
+      for (int k = 0; k < j; ++k) a -= L[6 * i + k] * L[6 * j + k];
+      L[6 * i + j] = a * inv;
+    }
+    for (int i = 0; i < j; ++i) L[6 * i + j] = 0.0;
+  }
+  return true;
+}
+// X ← L⁻¹ X (X has 6 rows).
+template <class M>
+void lower_solve(const double* L, M& X) {
+  for (int i = 0; i < 6; ++i) {
+    for (int k = 0; k < i; ++k) X.row(i) -= L[6 * i + k] * X.row(k);
+    X.row(i) *= L[7 * i];
+  }
+}
+// X ← L⁻ᵀ X.
+template <class M>
+void upper_solve(const double* L, M& X) {
+  for (int i = 5; i >= 0; --i) {
+    for (int k = i + 1; k < 6; ++k) X.row(i) -= L[6 * k + i] * X.row(k);
+    X.row(i) *= L[7 * i];
+  }
+}
 }  // namespace
 
 bool ChainSolver::sweep_factor(double* v, const Sweep& s, MatX& schur) const {
@@ -90,32 +127,32 @@ bool ChainSolver::sweep_factor_w(double* v, const Sweep& s, MatX& schur) const {
   schur.setZero(6 + w, 6 + w);
   if (s.count == 0) return true;
   Eigen::Matrix<double, W, W> acc = Eigen::Matrix<double, W, W>::Zero(w, w);  // Σ W_kᵀ W_k
-  // In place: D_k ← L_k (lower Cholesky factor), the coupling slot of k ← F_k = L_prev⁻¹ S(prev, k),
+  // In place: D_k ← L_k (lower Cholesky factor, diagonal inverted), the coupling slot of k ← F_k = L_prev⁻¹ S(prev, k),
   // B_k ← W_k = L_k⁻¹ (B_k − F_kᵀ W_prev).
   int prev = -1;
   for (int i = 0; i < s.count; ++i) {
     const int k = s.first + i * s.step;
-    Block D(v + pattern_.diag(k));
-    Mat6 Dk = D.selfadjointView<Eigen::Upper>();
+    double* L = v + pattern_.diag(k);
+    Mat6 Dk = Block(L).selfadjointView<Eigen::Upper>();
     BorderW<W> B(v + pattern_.border(k), 6, w);
     if (prev >= 0) {
-      const Mat6 F = CBlock(v + pattern_.diag(prev)).triangularView<Eigen::Lower>().solve(coupling(v, prev, k));
+      Mat6 F = coupling(v, prev, k);
+      lower_solve(v + pattern_.diag(prev), F);
       Block(v + factor_slot(prev, k)) = F;
       Dk.noalias() -= F.transpose() * F;
       if (w > 0) B.noalias() -= F.transpose() * CBorderW<W>(v + pattern_.border(prev), 6, w);
     }
-    Eigen::LLT<Mat6> llt(Dk);
-    if (llt.info() != Eigen::Success) return false;
-    D = llt.matrixL().toDenseMatrix();
+    if (!cholesky6(Dk, L)) return false;
     if (w > 0) {
-      D.template triangularView<Eigen::Lower>().solveInPlace(B);
+      lower_solve(L, B);
       acc.noalias() += B.transpose() * B;
     }
     prev = k;
   }
   schur.bottomRightCorner(w, w) = acc;
   // The last block's coupling to the separator, eliminated: F_sep = L_last⁻¹ S(last, p).
-  const Mat6 Fs = CBlock(v + pattern_.diag(prev)).triangularView<Eigen::Lower>().solve(coupling(v, s.sep, prev).transpose());
+  Mat6 Fs = coupling(v, s.sep, prev).transpose();
+  lower_solve(v + pattern_.diag(prev), Fs);
   Block(v + factor_slot(prev, s.sep)) = Fs;
   schur.topLeftCorner<6, 6>().noalias() += Fs.transpose() * Fs;
   if (w > 0) {
@@ -181,7 +218,7 @@ void ChainSolver::sweep_forward_w(const Sweep& s, VecX& b, VecX& y_iface) const 
     const int k = s.first + i * s.step;
     Vec6 r = b.segment<6>(6 * k);
     if (prev >= 0) r.noalias() -= CBlock(v + factor_slot(prev, k)).transpose() * prev_y;
-    CBlock(v + pattern_.diag(k)).triangularView<Eigen::Lower>().solveInPlace(r);
+    lower_solve(v + pattern_.diag(k), r);
     b.segment<6>(6 * k) = r;
     if (w > 0) y.noalias() += CBorderW<W>(v + pattern_.border(k), 6, w).transpose() * r;
     prev_y = r;
@@ -204,7 +241,7 @@ void ChainSolver::sweep_backward_w(const Sweep& s, VecX& b, const VecX& x_iface)
     Vec6 r = b.segment<6>(6 * k);
     r.noalias() -= CBlock(v + factor_slot(k, next)) * x_next;
     if (w > 0) r.noalias() -= CBorderW<W>(v + pattern_.border(k), 6, w) * xb;
-    CBlock(v + pattern_.diag(k)).transpose().triangularView<Eigen::Upper>().solveInPlace(r);
+    upper_solve(v + pattern_.diag(k), r);
     b.segment<6>(6 * k) = r;
     x_next = r;
     next = k;

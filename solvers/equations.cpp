@@ -42,7 +42,7 @@ EquationsOfMotion::EquationsOfMotion(std::shared_ptr<const Model> model_ptr, std
     RFEM_CHECK_ARGUMENT(inputs[j].motion || inputs[j].torque,
                         "joint " + std::to_string(j + 1) + " has neither a motion law nor a torque law");
   const int n6 = model.flexible_dofs();
-  for (int i = 0; i < n6; ++i) unknown_.push_back(i);
+  for (int i = 0; i < n6; ++i) unknown_.push_back(i);  // a prefix in order: expand() copies it as a block
   base_col_.assign(model.m(), -1);
   for (int j = 0; j < model.m(); ++j)
     if (!inputs[j].prescribed()) {
@@ -62,14 +62,20 @@ EquationsOfMotion::EquationsOfMotion(std::shared_ptr<const Model> model_ptr, std
 }
 
 void EquationsOfMotion::expand(double t, const double* qu, const double* vu, const double* au) {
-  const int N = model_->dof(), u = unknowns();
-  q_.setZero(N);
-  v_.setZero(N);
-  a_.setZero(N);
-  for (int i = 0; i < u; ++i) {
+  // Every coordinate is set below: the rfes' are the first unknowns, in order (the constructor), and
+  // every joint is either prescribed or unknown.
+  const int N = model_->dof(), u = unknowns(), n6 = model_->flexible_dofs();
+  q_.resize(N);
+  v_.resize(N);
+  a_.resize(N);
+  q_.head(n6) = Eigen::Map<const VecX>(qu, n6);
+  v_.head(n6) = Eigen::Map<const VecX>(vu, n6);
+  if (au) a_.head(n6) = Eigen::Map<const VecX>(au, n6);
+  else a_.setZero();
+  for (int i = n6; i < u; ++i) {
     q_[unknown_[i]] = qu[i];
     v_[unknown_[i]] = vu[i];
-    if (au) a_[unknown_[i]] = au[i];
+    a_[unknown_[i]] = au ? au[i] : 0.0;
   }
   for (int j = 0; j < model_->m(); ++j)
     if (inputs_[j].prescribed()) {
@@ -100,7 +106,9 @@ Power EquationsOfMotion::residual(double t, const double* qu, const double* vu, 
   }
   const VecX tau = torques(t);
   const int u = unknowns(), m = model_->m();
-  for (int i = 0; i < u; ++i) r[i] = F_[unknown_[i]];
+  const int n6 = model_->flexible_dofs();  // the first unknowns, in order
+  Eigen::Map<VecX>(r, n6) = F_.head(n6);
+  for (int i = n6; i < u; ++i) r[i] = F_[unknown_[i]];
   for (int j = 0; j < m; ++j)
     if (base_col_[j] >= 0) r[base_col_[j]] -= tau[j];
   p.input = tau.dot(model_->joint_coords(v_));

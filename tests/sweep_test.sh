@@ -66,8 +66,32 @@ for sig in KILL INT; do
   rm -rf k.h5 k.runs
   "$rfem" sweep k.toml --jobs 1 -q 2>/dev/null &
   pid=$!
-  for i in $(seq 1 6000); do [ "$(completed k.h5)" -ge 1 ] && break; sleep 0.05; done
-  sleep 0.4  # (the next point under way, past a checkpoint)
+  # Kill once a point after the first has written a checkpoint early in its run (≤ 32 of its 81
+  # output rows): the signal then lands inside that point however fast points run (a fixed delay
+  # after the first point's end raced the next point's start).
+  /usr/bin/python3 - <<'PY' || { echo "FAIL: SIG$sig: no point after the first wrote an early checkpoint"; exit 1; }
+import sys, time
+import h5py
+def done():
+    try:
+        with h5py.File("k.h5", "r") as f:
+            return list(f.attrs["status"]).count("completed")
+    except Exception:
+        return 0
+end = time.time() + 600
+while time.time() < end:
+    d = done()
+    if d >= 1:
+        try:
+            with h5py.File(f"k.runs/run{d:04d}.h5", "r", swmr=True) as r:
+                slots = r["run/checkpoint"][:, :3]  # magic, sequence, rows
+            if any(0 < s[2] <= 32 for s in slots if s[0] != 0) and done() == d:
+                sys.exit(0)
+        except Exception:
+            pass
+    time.sleep(0.01)
+sys.exit(1)
+PY
   kill -$sig "$pid"
   set +e
   wait "$pid"
