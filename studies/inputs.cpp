@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <mutex>
 
 #include "rfem/assembly/assemble.hpp"
 #include "rfem/results/reader.hpp"
@@ -150,21 +152,34 @@ std::vector<JointInput> rigid_torque_inputs(std::shared_ptr<const Model> rigid, 
     throw std::invalid_argument("rigid_torque_inputs: one law per joint is required (" + std::to_string(rigid->m()) + ")");
   for (const JointInput& l : laws)
     if (!l.motion) throw std::invalid_argument("rigid_torque_inputs: every joint needs a motion law");
+  // The joints' laws share the inverse dynamics at the last time asked: a residual asks every joint
+  // at one time, and a stage's Newton iterations ask at the same time again. (Locked: two runs may
+  // share these inputs.)
+  struct Last {
+    std::mutex m;
+    double t = std::numeric_limits<double>::quiet_NaN();
+    VecX F;
+  };
+  const auto last = std::make_shared<Last>();
   std::vector<JointInput> out(laws.size());
   for (size_t j = 0; j < laws.size(); ++j) {
     out[j].q0 = laws[j].q0;
     out[j].v0 = laws[j].v0;
-    out[j].torque = torque_function([rigid, laws, j](double t) {
-      const int m = rigid->m();
-      VecX q(m), v(m), a(m), F;
-      for (int i = 0; i < m; ++i) {
-        const MotionSample s = laws[i].motion->at(t);
-        q[i] = s.q;
-        v[i] = s.qd;
-        a[i] = s.qdd;
+    out[j].torque = torque_function([rigid, laws, j, last](double t) {
+      const std::lock_guard<std::mutex> lock(last->m);
+      if (!(last->t == t)) {
+        const int m = rigid->m();
+        VecX q(m), v(m), a(m);
+        for (int i = 0; i < m; ++i) {
+          const MotionSample s = laws[i].motion->at(t);
+          q[i] = s.q;
+          v[i] = s.qd;
+          a[i] = s.qdd;
+        }
+        generalised_forces(*rigid, q, v, a, ForceTerms{}, last->F);
+        last->t = t;
       }
-      generalised_forces(*rigid, q, v, a, ForceTerms{}, F);
-      return F[static_cast<long>(j)];
+      return last->F[static_cast<long>(j)];
     }, all_breakpoints(laws));
   }
   return out;
