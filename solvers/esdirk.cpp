@@ -71,12 +71,34 @@ Tableau load_tableau(const std::string& name) {
   return T;
 }
 
-// Weighted max norm of a stage increment δα as the change it makes in [Q; V] = [(hγ)² δα; hγ δα].
+// Weighted max norm of a stage increment δα as the change it makes in [Q; V] = [(hγ)² δα; hγ δα];
+// NaN or inf if δα is not finite (then no test passes). Two vectorised reductions: a running
+// std::max over the unknowns was the integrator's largest serial cost.
 double wmax_increment(const VecX& da, double hg, const VecX& w) {
-  const int u = static_cast<int>(da.size());
-  double s = 0.0;
-  for (int i = 0; i < u; ++i) s = std::max({s, std::abs(hg * hg * da[i] * w[i]), std::abs(hg * da[i] * w[u + i])});
-  return s;
+  const long u = da.size();
+  if (u == 0) return 0.0;
+  const double mq = (da.array() * w.head(u).array()).abs().maxCoeff<Eigen::PropagateNaN>();
+  const double mv = (da.array() * w.tail(u).array()).abs().maxCoeff<Eigen::PropagateNaN>();
+  if (std::isnan(mq) || std::isnan(mv)) return mq + mv;  // (std::max would drop a NaN second argument)
+  return std::max(hg * hg * mq, hg * mv);
+}
+
+// out_k = x_k + Σ_{j<m} c_j y_j for two outputs over the same y's, in one pass over memory (blocks that
+// stay in cache); each element sums in the order of the vector operations it replaces (same bits).
+void combine(VecX& out1, const VecX& x1, const double* c1, VecX& out2, const VecX& x2, const double* c2,
+             const std::vector<VecX>& y, int m) {
+  const long u = x1.size();
+  constexpr long kBlock = 512;
+  for (long b0 = 0; b0 < u; b0 += kBlock) {
+    const long n = std::min(kBlock, u - b0);
+    auto o1 = out1.segment(b0, n), o2 = out2.segment(b0, n);
+    o1 = x1.segment(b0, n);
+    o2 = x2.segment(b0, n);
+    for (int j = 0; j < m; ++j) {
+      o1 += c1[j] * y[j].segment(b0, n);
+      o2 += c2[j] * y[j].segment(b0, n);
+    }
+  }
 }
 
 // Weighted RMS norm over [x_q; x_v] with weights w (size 2u).
@@ -188,6 +210,7 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
 
   std::vector<VecX> alpha(s, VecX::Zero(u));
   std::vector<Power> Ps(s);
+  std::vector<double> cq(s), cv(s);  // the coefficients of a combination of the stages
   // 7 + s vectors of the unknowns' size (memory per rfe matters at 10⁴ rfes): after the stages Q, V
   // hold the new solution and Qk, Vk the error estimate.
   VecX w(2 * u), Qk(u), Vk(u), Q(u), V(u);
@@ -283,12 +306,12 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
       Ps[0] = P;
       for (int i = 1; i < s && converged; ++i) {
         const double ti = t + T.c[i] * h;
-        Vk = v;
-        Qk = q + (T.c[i] * h) * v;
+        Q = q + (T.c[i] * h) * v;  // (Q is free until the Newton iteration)
         for (int j = 0; j < i; ++j) {
-          Vk += (h * T.A(i, j)) * alpha[j];
-          Qk += (h * h * T.AA(i, j)) * alpha[j];
+          cv[j] = h * T.A(i, j);
+          cq[j] = h * h * T.AA(i, j);
         }
+        combine(Vk, v, cv.data(), Qk, Q, cq.data(), alpha, i);
         alpha[i] = alpha[i - 1];  // predictor (extrapolations measured no better)
         double dn_prev = 0.0;
         eta = std::pow(std::max(eta, 1e-16), 0.8);
@@ -299,14 +322,13 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
           Ps[i] = eq.residual(ti, Q.data(), V.data(), alpha[i].data(), r.data());
           ++st.residual_evals;
           ++st.newton_iters;
-          if (!r.allFinite()) {
+          eq.solve_newton(r);  // −δα (a residual that is not finite gives a δα that is not)
+          const double dn = wmax_increment(r, hg, w);
+          if (!std::isfinite(dn)) {
             nonfinite = true;
             break;
           }
-          eq.solve_newton(r);
-          r = -r;  // δα
-          alpha[i] += r;
-          const double dn = wmax_increment(r, hg, w);
+          alpha[i] -= r;
           if (it > 0) {  // contraction rate; give up if it cannot make it within the iterations left
             const double theta = dn / dn_prev;
             if (theta >= 0.99) break;
@@ -316,6 +338,7 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
           if (eta * dn <= kNewtonTol || dn < 1e-12) {
             converged = true;
             // The power was evaluated before this last update: carry it to the converged stage.
+            r = -r;  // δα
             const Power dP = eq.power_change(ti, V.data(), r, hg);
             Ps[i].input += dP.input;
             Ps[i].dissipation += dP.dissipation;
@@ -336,12 +359,12 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
       // Solution (stiffly accurate: the last stage) and error estimate.
       Q = Qk + (hg * hg) * alpha[s - 1];  // q1
       V = Vk + hg * alpha[s - 1];         // v1
-      eqv.setZero();
-      evv.setZero();
       for (int j = 0; j < s; ++j) {
-        eqv += (h * h * T.eq[j]) * alpha[j];
-        evv += (h * T.ev[j]) * alpha[j];
+        cq[j] = h * h * T.eq[j];
+        cv[j] = h * T.ev[j];
       }
+      r.setZero();  // (free until the next stage)
+      combine(eqv, r, cq.data(), evv, r, cv.data(), alpha, s);
       weights(q, v, &q1, &v1);
       const double err = std::max(wrms(eqv, evv, w), 1e-10);
       const double expo = 1.0 / (T.embedded_order + 1);
