@@ -49,14 +49,15 @@ Mat6 ChainSolver::coupling(const double* v, int prev, int k) const {
 }
 
 namespace {
-// Calls f(std::integral_constant<int, W>) with W = w for 1 ≤ w ≤ 12, else W = Eigen::Dynamic.
+// Calls f(std::integral_constant<int, W>) with W = w for 0 ≤ w ≤ 12, else W = Eigen::Dynamic (0: a chain
+// with no border columns, every joint prescribed).
 template <class F>
 decltype(auto) with_width(int w, F&& f) {
   switch (w) {
 #define RFEM_WIDTH(n) \
   case n:             \
     return f(std::integral_constant<int, n>{});
-    RFEM_WIDTH(1) RFEM_WIDTH(2) RFEM_WIDTH(3) RFEM_WIDTH(4) RFEM_WIDTH(5) RFEM_WIDTH(6)
+    RFEM_WIDTH(0) RFEM_WIDTH(1) RFEM_WIDTH(2) RFEM_WIDTH(3) RFEM_WIDTH(4) RFEM_WIDTH(5) RFEM_WIDTH(6)
     RFEM_WIDTH(7) RFEM_WIDTH(8) RFEM_WIDTH(9) RFEM_WIDTH(10) RFEM_WIDTH(11) RFEM_WIDTH(12)
 #undef RFEM_WIDTH
     default:

@@ -42,7 +42,7 @@ class ChainSolver : public LinearSolver {
   // Where the factor's coupling between consecutive blocks a, b of a sweep is kept: the slot of
   // the coupling between them.
   long factor_slot(int a, int b) const { return pattern_.coupling(std::max(a, b)); }
-  // The sweeps, with fixed-size kernels for border widths W = 1 … 12 (Eigen::Dynamic otherwise):
+  // The sweeps, with fixed-size kernels for border widths W = 0 … 12 (Eigen::Dynamic otherwise):
   // the per-block products are small, and unrolled ones cost a fraction of general ones.
   bool sweep_factor(double* v, const Sweep& s, MatX& schur) const;
   void sweep_forward(const Sweep& s, VecX& b, VecX& y_iface) const;
