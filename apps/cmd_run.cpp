@@ -8,6 +8,7 @@
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/recorders.hpp"
 #include "rfem/studies/resume.hpp"
+#include "rfem/studies/run_file.hpp"
 
 namespace rfem::app {
 
@@ -126,30 +127,22 @@ int resume_simulation(const Common& c, const RunOptions& o) {
 
 int run_simulation(const Common& c, const RunOptions& o) {
   if (!o.resume.empty()) return resume_simulation(c, o);
-  const std::string& output = o.output;
   const Case cs = read_checked_case(c);
-  if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: missing table (t_end, output_dt, …) for `rfem run`");
-  if (cs.joints.empty()) throw CaseError(cs.path + ": joints: `rfem run` needs at least one base joint");
-  const auto model = model_of(cs, c.n);
-  const std::vector<JointInput> inputs = joint_inputs(cs, print_warning);  // bad inputs fail before any file is written
   const bool quiet = c.json || c.quiet;
-  check_run_cost(cs, model, inputs, c);
   RunRequest rq;
+  rq.n = c.n;
   const SignalStop signals(rq.stop);
-  ResultsWriter file = create_results(output, describe(cs, c.command_line, to_string(cs.sim.procedure), model->n(), max_threads(c), c.n));
-  if (!quiet)
-    fmt::print("rfem run {}: n = {} rfes{}, m = {} joints, t_end = {} s, {} thread(s) -> {}\n", cs.path, model->n(),
-               model->links.size() > 1 ? fmt::format(" in {} links", model->links.size()) : "", model->m(),
-               cs.sim.options.t_end, max_threads(c), output);
-  Hdf5Recorder recorder(file);
   Console console(quiet);
-  rq.observers = {&recorder};
   console.attach(rq, c, o);
-  const std::vector<RunResult> runs = run_case(cs, model, inputs, rq);
-  file.close();
-  // ParaView's view of every run that stored its poses (also of a failed run: what it computed).
-  const std::vector<std::string> xdmf = write_views(cs, *model, output, print_warning);
-  return report(cs.path, model->n(), output, runs, xdmf, c, quiet);
+  const FileRuns f = run_into_file(cs, rq, o.output, c.command_line, [&](const std::shared_ptr<const Model>& mp, const std::vector<JointInput>& inputs) {
+    check_run_cost(cs, mp, inputs, c);
+    const Model& model = *mp;
+    if (!quiet)
+      fmt::print("rfem run {}: n = {} rfes{}, m = {} joints, t_end = {} s, {} thread(s) -> {}\n", cs.path, model.n(),
+                 model.links.size() > 1 ? fmt::format(" in {} links", model.links.size()) : "", model.m(),
+                 cs.sim.options.t_end, max_threads(c), o.output);
+  });
+  return report(cs.path, f.model->n(), o.output, f.runs, f.views, c, quiet);
 }
 
 }  // namespace rfem::app

@@ -15,22 +15,26 @@
 
 namespace {
 
-// Positive integers only, with a message that says so (CLI11's range check prints the largest
-// double). Runs on the text, before any conversion.
-const CLI::Validator kPositiveInt(
-    [](std::string& s) -> std::string {
-      size_t used = 0;
-      long v = 0;
-      try {
-        v = std::stol(s, &used);
-      } catch (...) {
-        used = 0;
-      }
-      if (used == 0 || used != s.size() || v < 1 || v > 100000000)
-        return "must be a positive integer (got '" + s + "')";
-      return "";
-    },
-    "POSITIVE");
+// Positive integers up to `max` only, with a message that says so (CLI11's range check prints the
+// largest double). Runs on the text, before any conversion.
+CLI::Validator positive_int(long max) {
+  return CLI::Validator(
+      [max](std::string& s) -> std::string {
+        size_t used = 0;
+        long v = 0;
+        try {
+          v = std::stol(s, &used);
+        } catch (...) {
+          used = 0;
+        }
+        if (used == 0 || used != s.size() || v < 1 || v > max)
+          return "must be a positive integer up to " + std::to_string(max) + " (got '" + s + "')";
+        return "";
+      },
+      "POSITIVE");
+}
+const CLI::Validator kPositiveInt = positive_int(100000000);
+const CLI::Validator kRfes = positive_int(rfem::kMaxRfes);  // the case file's own limit
 
 }  // namespace
 
@@ -51,7 +55,7 @@ int main(int argc, char** argv) {
     sub->add_option("case", common.case_path, "case file (TOML)")->required();
     sub->add_option("--set", common.overrides, "override a case value: key.path=value (repeatable)");
     if (single_n)
-      sub->add_option("--n", common.n, "number of rfes, distributed over the segments by length")->check(kPositiveInt);
+      sub->add_option("--n", common.n, "number of rfes, distributed over the segments by length")->check(kRfes);
     sub->add_flag("--json", common.json, "print results as JSON");
     sub->add_flag("-q,--quiet", common.quiet, "no progress line or summary");
     sub->add_flag("-v,--verbose", common.verbose, "log solver events to stderr");
@@ -119,7 +123,7 @@ int main(int argc, char** argv) {
   auto* rf = app.add_subcommand("refine", "convergence tables of quantities over a series of n");
   add_common(rf, false);
   RefineOptions ro;
-  rf->add_option("--n", ro.ns, "the series of n, increasing: --n 6,12,24")->delimiter(',')->check(kPositiveInt)->required();
+  rf->add_option("--n", ro.ns, "the series of n, increasing: --n 6,12,24")->delimiter(',')->check(kRfes)->required();
   rf->add_option("--quantity", ro.quantities,
                  "one or more (comma-separated, from the same runs): static tip:ux|uy|uz|rx|ry|rz; modes mode:K, "
                  "bending-y:K, bending-z:K, axial:K, torsion:K; dynamic [RUN/]peak:u1|u2|theta, [RUN/]u1@T, u2@T, "

@@ -109,6 +109,8 @@ long BorderedPattern::slot(int r, int c) const {
 }
 
 void BorderedPattern::multiply(const std::vector<double>& v, const VecX& x, VecX& y) const {
+  RFEM_CHECK_ARGUMENT_SIZE(v.size(), nnz(), "values");
+  RFEM_CHECK_ARGUMENT_SIZE(x.size(), size(), "x");
   using RowMat6 = Eigen::Matrix<double, 6, 6, Eigen::RowMajor>;
   using Border = Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>;
   const int n6 = 6 * nblocks_;
@@ -166,6 +168,7 @@ const BorderedPattern::Csc& BorderedPattern::csc() const {
 }
 
 MatX to_dense(const BorderedPattern& pattern, const std::vector<double>& values) {
+  RFEM_CHECK_ARGUMENT_SIZE(values.size(), pattern.nnz(), "values");
   const auto& z = pattern.csc();
   MatX A = MatX::Zero(pattern.size(), pattern.size());
   for (int c = 0; c < pattern.size(); ++c)

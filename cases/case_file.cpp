@@ -233,6 +233,14 @@ Case parse_case(const std::string& text, const std::string& path, const std::vec
 }
 
 std::vector<std::vector<int>> link_parts(const Case& c, int n) {
+  // (The caller's n: "--n" on the command line, `n` in Python and the library.)
+  if (n < 0 || n > kMaxRfes)
+    throw CaseError(c.path + ": --n " + std::to_string(n) + ": must be 1 to " + std::to_string(kMaxRfes) + " rfes");
+  size_t segments = 0;
+  for (const LinkCase& l : c.links) segments += l.link.segments.size();
+  if (n > 0 && segments == 0)
+    throw CaseError(c.path + ": --n " + std::to_string(n) +
+                    ": the case has no flexible link ([link] or [[links]]) to divide into rfes; a rigid manipulator takes no n");
   std::vector<std::vector<int>> parts;
   for (const LinkCase& l : c.links) {
     parts.emplace_back();

@@ -22,6 +22,10 @@ class CaseError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The most rfes a link, a segment or a whole model may have (`n`, `parts`, `--n`, Python's `n`):
+/// far beyond memory, it guards int overflow and an allocation that cannot succeed.
+inline constexpr long kMaxRfes = 10000000;
+
 /// A joint's input in a time integration (`joints[].input`); the kinds are documented in README.md.
 struct InputSpec {
   InputKind kind = InputKind::Torque;
@@ -104,7 +108,8 @@ Case parse_case(const std::string& text, const std::string& name = "<text>",
 Case with_overrides(const Case& c, const std::vector<std::string>& more);
 
 /// Builds the model with n rfes in all (n > 0: distributed over every link's segments by length;
-/// n == 0: each link's own discretisation). Throws CaseError for an impossible discretisation.
+/// n == 0: each link's own discretisation). Throws CaseError for an impossible discretisation, for
+/// n < 0 or n > kMaxRfes, and for n > 0 in a case without a flexible link.
 Model build_model(const Case& c, int n = 0);
 /// The number of parts of each link's segments for n rfes in all (as build_model distributes them).
 std::vector<std::vector<int>> link_parts(const Case& c, int n);

@@ -14,7 +14,7 @@
 
 namespace rfem::reading {
 
-constexpr long kMaxRfes = 10000000;  // far beyond memory; guards int overflow of n and parts
+using rfem::kMaxRfes;  // (case_file.hpp)
 
 /// TOML text parsed, or CaseError "path:line: syntax error: …".
 inline toml::table parse_toml(const std::string& text, const std::string& path) {

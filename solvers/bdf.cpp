@@ -28,6 +28,7 @@ struct Bdf {
   VecX r;               // residual scratch (unknowns)
   void* ida = nullptr;  // for the heartbeat's step count
   std::string error;    // what a callback caught (IDA itself only sees a flag)
+  std::string ida_message;  // IDA's own text of its last error (it outlives IDA: declared first)
   int caught(const std::exception& e) {
     if (error.empty()) error = e.what();
     return -1;  // unrecoverable
@@ -128,7 +129,7 @@ void check(int flag, const char* what) {
 }  // namespace
 
 RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, SampleEmitter& emit) {
-  Bdf p{eq, emit, 0.0, VecX(), nullptr, {}};
+  Bdf p{eq, emit, 0.0, VecX(), nullptr, {}, {}};
   const int u = eq.unknowns(), N = 2 * u + 2;
   const long n_out = output_count(opts);
   RunOutcome out;
@@ -195,7 +196,7 @@ RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, S
   N_VDestroy(abstol);
   check(tol_flag, "IDASVtolerances");
   check(IDASetUserData(h.ida, &p), "IDASetUserData");
-  check(sundials::silence_ida(h.ida, h.ctx), "silencing IDA");
+  check(sundials::capture_ida_messages(h.ida, h.ctx, &p.ida_message), "setting IDA's error handler");
   check(IDASetMaxNumSteps(h.ida, opts.max_steps), "IDASetMaxNumSteps");
   if (opts.max_step > 0) check(IDASetMaxStep(h.ida, opts.max_step), "IDASetMaxStep");
   check(IDASetMaxOrd(h.ida, opts.max_order), "IDASetMaxOrd");
@@ -245,7 +246,10 @@ RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, S
     char buf[160];
     std::snprintf(buf, sizeof buf, " at t = %.6g s (last step %.3g s)", tcur, out.stats.last_step);
     if (flag < 0) {
-      out.status = RunStatus::failed((p.error.empty() ? "IDA " + flag_name(flag) : p.error) + buf +
+      // What a callback caught, else IDA's flag with its own message.
+      const std::string why = !p.error.empty() ? p.error
+                              : "IDA " + flag_name(flag) + (p.ida_message.empty() ? "" : " (" + p.ida_message + ")");
+      out.status = RunStatus::failed(why + buf +
                                      "; try looser tolerances, a smaller max_step, or check the inputs");
       return out;
     }

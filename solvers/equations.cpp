@@ -62,6 +62,7 @@ EquationsOfMotion::EquationsOfMotion(std::shared_ptr<const Model> model_ptr, std
 }
 
 void EquationsOfMotion::expand(double t, const double* qu, const double* vu, const double* au) {
+  RFEM_CHECK_ARGUMENT(unknowns() == 0 || (qu && vu), "qu and vu must point to unknowns() values");
   // Every coordinate is set below: the rfes' are the first unknowns, in order (the constructor), and
   // every joint is either prescribed or unknown.
   const int N = model_->dof(), u = unknowns(), n6 = model_->flexible_dofs();
@@ -96,6 +97,7 @@ VecX EquationsOfMotion::torques(double t) const {
 }
 
 Power EquationsOfMotion::residual(double t, const double* qu, const double* vu, const double* au, double* r) {
+  RFEM_CHECK_ARGUMENT(unknowns() == 0 || r, "r must point to unknowns() values");
   const auto start = std::chrono::steady_clock::now();
   expand(t, qu, vu, au);
   Power p;
@@ -116,6 +118,8 @@ Power EquationsOfMotion::residual(double t, const double* qu, const double* vu, 
 }
 
 Power EquationsOfMotion::power_change(double t, const double* vu, const VecX& da, double hg) {
+  RFEM_CHECK_ARGUMENT(unknowns() == 0 || vu, "vu must point to unknowns() values");
+  RFEM_CHECK_ARGUMENT_SIZE(da.size(), unknowns(), "da");
   Power d;
   const MatX& rows = newton_->base_rows();
   for (int j = 0; j < model_->m(); ++j) {
@@ -184,6 +188,7 @@ void EquationsOfMotion::report_step(double seconds, long residuals) {
 }
 
 bool EquationsOfMotion::setup_newton(double t, const double* qu, const double* vu, double h) {
+  RFEM_CHECK_ARGUMENT(h > 0 && std::isfinite(h), "the step h must be positive and finite");
   expand(t, qu, vu, nullptr);
   return newton_->setup(q_, v_, h, ws_);
 }

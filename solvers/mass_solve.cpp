@@ -1,9 +1,14 @@
 #include "rfem/solvers/mass_solve.hpp"
+#include "rfem/core/check.hpp"
 
 namespace rfem {
 
 bool solve_mass(const Model& model, const BorderedPattern& pattern, const std::vector<int>& base_col,
                 const VecX& q, const VecX& v, VecX& b, std::vector<double>& values) {
+  RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
+  RFEM_CHECK_ARGUMENT_SIZE(v.size(), model.dof(), "v");
+  RFEM_CHECK_ARGUMENT_SIZE(base_col.size(), model.m(), "base_col");
+  RFEM_CHECK_ARGUMENT_SIZE(b.size(), pattern.size(), "b");
   MatrixTerms mt;
   mt.mass = 1.0;
   assemble_matrices(model, pattern, base_col, q, v, mt, values, {});

@@ -1,4 +1,5 @@
 #include "rfem/solvers/newton_system.hpp"
+#include "rfem/core/check.hpp"
 
 #include <stdexcept>
 
@@ -56,6 +57,8 @@ void NewtonSystem::damping_times(const VecX& x, VecX& y) const {
 }
 
 void NewtonSystem::solve_bdf(const double* b, double* x, int threads) const {
+  RFEM_CHECK_ARGUMENT(b != nullptr && x != nullptr, "b and x must point to 2 × size() values");
+  RFEM_CHECK_ARGUMENT(h_ > 0, "no Newton matrix: call setup() first");
   const int u = size();
   const double c = 1.0 / h_;
   VecX Kb1;

@@ -1,4 +1,5 @@
 #include "rfem/solvers/statics.hpp"
+#include "rfem/core/check.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -13,6 +14,7 @@
 namespace rfem {
 
 Vec6 tip_generalised_force(const Model& model, int l, const Vec6& qn, const TipLoads& loads) {
+  RFEM_CHECK_INDEX(l, model.links.size(), "link");
   DeformationTransform d;
   deformation_transform(qn, d);
   Vec6 Q;

@@ -1,6 +1,7 @@
 #include <ida/ida.h>
 
 #include <stdexcept>
+#include <string>
 
 #include "rfem/solvers/sundials_impl.hpp"
 
@@ -19,13 +20,24 @@ Context::~Context() {
   if (ctx_) SUNContext_Free(&ctx_);
 }
 
-int silence_ida(void* ida_mem, const Context& ctx) {
+int capture_ida_messages(void* ida_mem, const Context& ctx, std::string* last) {
 #if SUNDIALS_VERSION_MAJOR >= 7
   (void)ida_mem;
-  return SUNContext_ClearErrHandlers(ctx.get());
+  if (const int flag = SUNContext_ClearErrHandlers(ctx.get()); flag != 0) return flag;
+  return SUNContext_PushErrHandler(
+      ctx.get(),
+      [](int, const char*, const char*, const char* msg, SUNErrCode, void* data, SUNContext) {
+        if (msg) *static_cast<std::string*>(data) = msg;  // (no allocation can fail usefully here)
+      },
+      last);
 #else
   (void)ctx;
-  return IDASetErrHandlerFn(ida_mem, [](int, const char*, const char*, char*, void*) {}, nullptr);
+  return IDASetErrHandlerFn(
+      ida_mem,
+      [](int code, const char*, const char*, char* msg, void* data) {
+        if (code < 0 && msg) *static_cast<std::string*>(data) = msg;  // errors, not IDA's warnings
+      },
+      last);
 #endif
 }
 

@@ -1,5 +1,7 @@
 #include "rfem/studies/common.hpp"
 
+#include <cmath>
+
 namespace rfem {
 
 void joint_state(const Case& cs, const JointRate& r, VecX& qb, VecX& vb) {
@@ -9,6 +11,8 @@ void joint_state(const Case& cs, const JointRate& r, VecX& qb, VecX& vb) {
     if (r.joint < 1 || r.joint > static_cast<int>(cs.joints.size()))
       throw CaseError(cs.path + ": --joint " + std::to_string(r.joint) + ": the case has " +
                       std::to_string(cs.joints.size()) + " joints");
+    if (!std::isfinite(r.rate))
+      throw CaseError(cs.path + ": --rate " + std::to_string(r.rate) + ": must be a finite rate [rad/s or m/s]");
     vb[r.joint - 1] = r.rate;
   }
 }

@@ -153,6 +153,15 @@ RunResult run_one(const std::string& name, std::shared_ptr<const Model> model, c
   } catch (const std::exception& e) {  // (bad options or inputs): the run's record says why
     r.status = RunStatus::failed(e.what());
   }
+  // Progress once more where the run ended, so every run reports at least once however short it is
+  // (a caller's answer must not depend on wall time); a throwing callback fails a completed run.
+  if (rq.progress && r.t_reached > 0) {
+    try {
+      rq.progress({name, r.t_reached, o.t_end, r.stats.steps});
+    } catch (const std::exception& e) {
+      if (r.status.is_completed()) r.status = RunStatus::failed(e.what());
+    }
+  }
   s.wall_s = wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   s.status = r.status;
   s.stats = r.stats;
@@ -166,9 +175,13 @@ RunResult run_one(const std::string& name, std::shared_ptr<const Model> model, c
 
 }  // namespace
 
+void check_runnable(const Case& cs) {
+  if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: missing table (t_end, output_dt, …) for a run");
+  if (cs.joints.empty()) throw CaseError(cs.path + ": joints: a run needs at least one base joint");
+}
+
 std::vector<RunResult> run_case(const Case& cs, const RunRequest& rq) {
-  if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: missing table (t_end, output_dt, …) for `rfem run`");
-  if (cs.joints.empty()) throw CaseError(cs.path + ": joints: `rfem run` needs at least one base joint");
+  check_runnable(cs);
   const auto model = model_of(cs, rq.n);
   return run_case(cs, model, joint_inputs(cs, rq.warn), rq);
 }
@@ -176,7 +189,7 @@ std::vector<RunResult> run_case(const Case& cs, const RunRequest& rq) {
 std::vector<RunResult> run_case(const Case& cs, std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs,
                                 const RunRequest& rq) {
   if (!model) throw std::invalid_argument("run_case: no model");
-  if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: missing table (t_end, output_dt, …) for `rfem run`");
+  check_runnable(cs);
   if (static_cast<int>(inputs.size()) != model->m())
     throw std::invalid_argument("run_case: one input per joint is required (" + std::to_string(model->m()) + ")");
   const std::vector<RunName> all = runs_of(cs.sim.procedure);

@@ -113,7 +113,8 @@ struct RunRequest {
   std::string prefix;         ///< put before every run's name ("n12/")
   bool keep_series = true;    ///< keep every series in memory (RunResult::series)
   StopToken stop;             ///< request() ends the current run within a step, and the study
-  /// Called on the integrating thread at most every progress_interval seconds.
+  /// Called on the integrating thread at most every progress_interval seconds, and once at the end
+  /// of every run that got past t = 0 (where it ended), however short.
   std::function<void(const Progress&)> progress;
   double progress_interval = 0.2;
   std::vector<RunObserver*> observers;  ///< the caller keeps them alive for the call
@@ -126,6 +127,9 @@ struct RunRequest {
   std::vector<std::string> done;
   std::map<std::string, Checkpoint> resume;
 };
+
+/// CaseError unless the case can be run: a [simulation] table and at least one joint.
+void check_runnable(const Case& cs);
 
 /// Runs the case's procedure on its model with n rfes (CaseError for a case without
 /// [simulation] or joints, or bad inputs). A run that does not complete ends the procedure.

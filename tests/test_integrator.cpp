@@ -74,6 +74,22 @@ TEST(Integrator, EsdirkReachesItsDesignOrder) {
   }
 }
 
+TEST(Integrator, BdfFailureKeepsIdasOwnMessage) {
+  // Too few steps allowed: IDA stops with IDA_TOO_MUCH_WORK, and its own sentence (which names
+  // mxstep and the time) reaches the run's status instead of a bare flag.
+  Model m = test::spatial_arm(3, 1e-4, 1e-2);
+  const std::vector<JointInput> in{free_joint(0.2, 0.5, 0.5), free_joint(-0.3, 0.2, -0.2)};
+  IntegratorOptions o;
+  o.kind = IntegratorKind::Bdf;
+  o.t_end = 0.1;
+  o.output_dt = 0.1;
+  o.max_steps = 3;
+  const RunOutcome r = integrate(m, in, o, [](const OutputSample&) {});
+  ASSERT_EQ(r.status.kind, RunStatus::Kind::Failed) << r.status;
+  EXPECT_NE(r.status.reason.find("IDA_TOO_MUCH_WORK"), std::string::npos) << r.status;
+  EXPECT_NE(r.status.reason.find("mxstep"), std::string::npos) << r.status;
+}
+
 TEST(Integrator, DefaultTolerancesMeetTheAccuracyTarget) {
   // The paper's deployment at n = 6, first 5 s: at the default settings the tip deflections, the
   // torsion and the joint-3 torque (kinematic input) and the tip series (force input) are within

@@ -8,6 +8,9 @@
 #include <filesystem>
 
 #include "rfem/assembly/assemble.hpp"
+#include "rfem/solvers/equations.hpp"
+#include "rfem/solvers/mass_solve.hpp"
+#include "rfem/solvers/statics.hpp"
 #include "rfem/results/reader.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/recorders.hpp"
@@ -124,6 +127,42 @@ TEST(Library, EntryPointsRefuseWrongSizesAndBadInvariants) {
   o.t_end = 1.0;
   o.output_dt = 1e-19;  // 1e19 outputs
   EXPECT_THROW(check_options(o), std::invalid_argument);
+}
+
+TEST(Library, SolversRefuseWrongSizesAndMissingBuffers) {
+  // Each call would read or write past a buffer without its check.
+  const auto model = std::make_shared<const Model>(test::spatial_arm(4));
+  const Model& m = *model;
+  std::vector<int> cols(m.m());
+  for (int j = 0; j < m.m(); ++j) cols[j] = m.flexible_dofs() + j;  // every joint free, after the rfes
+  const BorderedPattern p(m, cols);
+  const VecX q = VecX::Zero(m.dof());
+  std::vector<double> values(p.nnz(), 0.0), short_values(p.nnz() - 1, 0.0);
+  VecX b = VecX::Zero(p.size()), short_b = VecX::Zero(p.size() - 1), y;
+  EXPECT_THROW(solve_mass(m, p, cols, q, q, short_b, values), std::invalid_argument);
+  EXPECT_THROW(solve_mass(m, p, {0}, q, q, b, values), std::invalid_argument);
+  EXPECT_THROW(solve_mass(m, p, cols, q.head(3), q, b, values), std::invalid_argument);
+  EXPECT_THROW(p.multiply(short_values, b, y), std::invalid_argument);
+  EXPECT_THROW(p.multiply(values, short_b, y), std::invalid_argument);
+  EXPECT_THROW(to_dense(p, short_values), std::invalid_argument);
+  EXPECT_THROW(tip_generalised_force(m, static_cast<int>(m.links.size()), Vec6::Zero(), TipLoads{}), std::invalid_argument);
+  EXPECT_THROW(tip_generalised_force(m, -1, Vec6::Zero(), TipLoads{}), std::invalid_argument);
+  std::vector<JointInput> inputs(m.m());
+  for (auto& in : inputs) in.torque = constant_torque(0.0);
+  EquationsOfMotion eq(model, inputs, ForceTerms{}, StopToken{}, LinearSolverKind::Chain, Parallelism{}, true);  // (K kept: IDA's solve)
+  VecX qu, vu;
+  eq.initial_state(qu, vu);
+  VecX r(eq.unknowns());
+  EXPECT_THROW(eq.residual(0.0, nullptr, vu.data(), nullptr, r.data()), std::invalid_argument);
+  EXPECT_THROW(eq.residual(0.0, qu.data(), vu.data(), nullptr, nullptr), std::invalid_argument);
+  EXPECT_THROW(eq.setup_newton(0.0, qu.data(), vu.data(), 0.0), std::invalid_argument);
+  EXPECT_THROW(eq.setup_newton(0.0, qu.data(), vu.data(), NAN), std::invalid_argument);
+  EXPECT_THROW(eq.power_change(0.0, vu.data(), VecX::Zero(eq.unknowns() + 1), 1e-3), std::invalid_argument);
+  std::vector<double> x2(2 * eq.unknowns()), b2(2 * eq.unknowns());
+  EXPECT_THROW(eq.solve_newton_bdf(b2.data(), x2.data()), std::invalid_argument);  // no setup yet
+  ASSERT_TRUE(eq.setup_newton(0.0, qu.data(), vu.data(), 1e-3));
+  EXPECT_THROW(eq.solve_newton_bdf(nullptr, x2.data()), std::invalid_argument);
+  EXPECT_NO_THROW(eq.solve_newton_bdf(b2.data(), x2.data()));
 }
 
 TEST(Library, RunStatusSurvivesItsText) {

@@ -1,0 +1,31 @@
+#pragma once
+// The one path from a case to its results file: `rfem run`, Python's rfem.run and a sweep's points
+// all run a case into a file through run_into_file (a resumed run goes through resume_case,
+// studies/resume.hpp, into the file it continues).
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rfem/studies/runs.hpp"
+
+namespace rfem {
+
+/// What run_into_file made: the model, every run's result, ParaView's views beside the file.
+struct FileRuns {
+  std::shared_ptr<const Model> model;
+  std::vector<RunResult> runs;
+  std::vector<std::string> views;
+};
+
+/// Runs the case's procedure into a new results file at `output`, in order: the case checked for
+/// a run (check_runnable), its model with rq.n rfes and its inputs (bad inputs fail here, before the
+/// file exists), the caller's `ready` (a cost check, a header line; it may throw to stop), the file
+/// created (a path that cannot be created is a CaseError), the runs recorded into it before rq's own
+/// observers see them, the file closed and ParaView's views written beside it (warnings through
+/// rq.warn). `made_by` is the command line or call kept in the file. Every row a run computed is in
+/// the file whatever its status.
+FileRuns run_into_file(const Case& cs, RunRequest rq, const std::string& output, const std::string& made_by,
+                       const std::function<void(const std::shared_ptr<const Model>&, const std::vector<JointInput>&)>& ready = {});
+
+}  // namespace rfem
