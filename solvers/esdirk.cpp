@@ -24,7 +24,8 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "rfem/solvers/integrator.hpp"
+#include "rfem/core/check.hpp"
+#include "rfem/solvers/esdirk_stepper.hpp"
 
 namespace rfem {
 
@@ -155,18 +156,61 @@ constexpr double kSafety = 0.9, kMinFactor = 0.2, kMaxFactor = 5.0;
 
 void check_esdirk_table(const std::string& name) { load_tableau(name); }
 
-RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, SampleEmitter& emit) {
-  const Tableau T = load_tableau(o.esdirk_table);
-  const int u = eq.unknowns(), s = T.s;
-  RunOutcome out;
-  IntegratorStats& st = out.stats;
-
-  // The start (static equilibrium, initial accelerations) can fail like any step: a status, not an
-  // exception. A resumed run starts from its checkpoint instead, its outputs so far delivered.
-  const IntegratorState* resume = emit.resume();
-  VecX q, v, a, r(u);
+// The integrator's state between steps, and its step loop (the equations and options are the
+// caller's; the tableau, stage vectors and step control are this object's).
+struct EsdirkStepper::Impl {
+  EquationsOfMotion& eq;
+  const IntegratorOptions o;
+  const Tableau T;
+  const int u, s;
+  IntegratorStats st;
+  VecX q, v, a, r;
   Power P;
   double Wd = 0.0, Wi = 0.0;  // dissipated energy, input work
+  std::vector<VecX> alpha;
+  std::vector<Power> Ps;
+  std::vector<double> cq, cv;  // the coefficients of a combination of the stages
+  // 7 + s vectors of the unknowns' size (memory per rfe matters at 10⁴ rfes): after the stages Q, V
+  // hold the new solution and Qk, Vk the error estimate.
+  VecX w, Qk, Vk, Q, V;
+  double h = 0.0, t = 0.0, err_prev = 1.0, eta = 1.0, t_reached = 0.0;
+  int max_newton = kMaxNewton;
+  bool last_rejected = false;
+  bool nonfinite = false;  // a residual or an error estimate was NaN or inf since the last accepted step
+  std::vector<double> breaks;
+  size_t next_break = 0;
+  long n_out = 0, k_out = 1, steps_this_output = 0, attempts_this_output = 0;
+  bool started = false;
+
+  Impl(EquationsOfMotion& e, const IntegratorOptions& opts)
+      : eq(e), o(opts), T(load_tableau(opts.esdirk_table)), u(e.unknowns()), s(T.s), r(u), alpha(s, VecX::Zero(u)),
+        Ps(s), cq(s), cv(s), w(2 * u), Qk(u), Vk(u), Q(u), V(u), breaks(e.breakpoints(opts.t_end)),
+        n_out(output_count(opts)) {}
+
+  void weights(const VecX& qa, const VecX& va, const VecX* qb, const VecX* vb) {
+    for (int i = 0; i < u; ++i) {
+      const double yq = qb ? std::max(std::abs(qa[i]), std::abs((*qb)[i])) : std::abs(qa[i]);
+      const double yv = vb ? std::max(std::abs(va[i]), std::abs((*vb)[i])) : std::abs(va[i]);
+      w[i] = 1.0 / (o.rtol * yq + o.atol);
+      w[u + i] = 1.0 / (o.rtol * yv + o.atol_velocity);
+    }
+  }
+  RunStatus fail(const std::string& why) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, " at t = %.6g s (step %.3g s)", t, h);
+    t_reached = std::max(t_reached, t);
+    return RunStatus::failed(why + buf + "; try looser tolerances, a smaller max_step, or check the inputs");
+  }
+  RunStatus start(SampleEmitter& emit);
+  RunStatus advance(double until, SampleEmitter& emit);
+  IntegratorState state() const;
+};
+
+RunStatus EsdirkStepper::Impl::start(SampleEmitter& emit) {
+  // The start (static equilibrium, initial accelerations) can fail like any step: a status, not an
+  // exception. A resumed run starts from its checkpoint instead, its outputs so far delivered.
+  started = true;
+  const IntegratorState* resume = emit.resume();
   if (resume) {
     if (resume->q.size() != u || resume->v.size() != u || resume->a.size() != u)
       throw std::invalid_argument("the state to resume from has " + std::to_string(resume->q.size()) +
@@ -180,53 +224,29 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
     st = resume->stats;
     if (resume->next_output < 1 || resume->next_output > output_count(o) + 1 || !(resume->h > 0))
       throw std::invalid_argument("the state to resume from does not fit the run's outputs (another t_end or output_dt?)");
-    out.t_reached = output_time(o, resume->next_output - 1);
+    t_reached = output_time(o, resume->next_output - 1);
   } else {
     try {
       eq.initial_state(q, v, o.initial == InitialState::Static);
       a = eq.accelerations(0.0, q.data(), v.data());
       P = eq.residual(0.0, q.data(), v.data(), a.data(), r.data());
     } catch (const std::exception& e) {
-      out.status = RunStatus::failed(at_start(e.what()));
-      return out;
+      return RunStatus::failed(at_start(e.what()));
     }
     ++st.residual_evals;
-    if (!q.allFinite() || !v.allFinite() || !a.allFinite()) {
-      out.status = RunStatus::failed("the initial state is not finite (check the inputs' values)");
-      return out;
-    }
+    if (!q.allFinite() || !v.allFinite() || !a.allFinite())
+      return RunStatus::failed("the initial state is not finite (check the inputs' values)");
     OutputSample s0;
     try {
       s0 = eq.sample(0.0, q.data(), v.data(), a.data(), 0.0, 0.0);
     } catch (const std::exception& e) {
-      out.status = RunStatus::failed(at_start(e.what()));
-      return out;
+      return RunStatus::failed(at_start(e.what()));
     }
-    if (!emit(s0)) {
-      out.status = emit.failure();
-      return out;
-    }
+    if (!emit(s0)) return emit.failure();
   }
-
-  std::vector<VecX> alpha(s, VecX::Zero(u));
-  std::vector<Power> Ps(s);
-  std::vector<double> cq(s), cv(s);  // the coefficients of a combination of the stages
-  // 7 + s vectors of the unknowns' size (memory per rfe matters at 10⁴ rfes): after the stages Q, V
-  // hold the new solution and Qk, Vk the error estimate.
-  VecX w(2 * u), Qk(u), Vk(u), Q(u), V(u);
-  VecX &q1 = Q, &v1 = V, &eqv = Qk, &evv = Vk;
-  auto weights = [&](const VecX& qa, const VecX& va, const VecX* qb, const VecX* vb) {
-    for (int i = 0; i < u; ++i) {
-      const double yq = qb ? std::max(std::abs(qa[i]), std::abs((*qb)[i])) : std::abs(qa[i]);
-      const double yv = vb ? std::max(std::abs(va[i]), std::abs((*vb)[i])) : std::abs(va[i]);
-      w[i] = 1.0 / (o.rtol * yq + o.atol);
-      w[u + i] = 1.0 / (o.rtol * yv + o.atol_velocity);
-    }
-  };
 
   // Initial step (Hairer & Wanner I, II.4): 1 % of the time for y to change by its own size.
   weights(q, v, nullptr, nullptr);
-  double h = 0.0;
   {
     const double d0 = wrms(q, v, w), d1 = wrms(v, a, w);
     h = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
@@ -236,28 +256,20 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
     if (o.fixed_step > 0) h = o.fixed_step;
   }
   if (resume) h = resume->h;
-
   // Fixed steps cannot be cut: give the Newton iteration room to reach the (tight) tolerance.
-  const int max_newton = o.fixed_step > 0 ? 60 : kMaxNewton;
-  double t = resume ? resume->t : 0.0, err_prev = resume ? resume->err_prev : 1.0, eta = resume ? resume->eta : 1.0;
-  bool last_rejected = false;
-  bool nonfinite = false;  // a residual or an error estimate was NaN or inf since the last accepted step
-  const std::vector<double> breaks = eq.breakpoints(o.t_end);
-  size_t next_break = 0;
-  const long n_out = output_count(o);
-  long k_out = resume ? resume->next_output : 1, steps_this_output = 0, attempts_this_output = 0;
-  auto t_output = [&](long k) { return output_time(o, k); };
-  auto fail = [&](const std::string& why) {
-    char buf[200];
-    std::snprintf(buf, sizeof buf, " at t = %.6g s (step %.3g s)", t, h);
-    out.status = RunStatus::failed(why + buf + "; try looser tolerances, a smaller max_step, or check the inputs");
-    out.t_reached = t;
-    return out;
-  };
-
+  max_newton = o.fixed_step > 0 ? 60 : kMaxNewton;
+  t = resume ? resume->t : 0.0;
+  err_prev = resume ? resume->err_prev : 1.0;
+  eta = resume ? resume->eta : 1.0;
+  k_out = resume ? resume->next_output : 1;
   eq.govern_by_steps();
+  return RunStatus{};
+}
+
+RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
+  auto t_output = [&](long k) { return output_time(o, k); };
   try {
-    while (k_out <= n_out) {
+    while (t < until && k_out <= n_out) {
       const auto step_start = std::chrono::steady_clock::now();
       const long residuals_before = st.residual_evals;
       // Every attempt (accepted or not) is timed for the thread governor.
@@ -270,14 +282,8 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
           eq.report_step(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), now - before);
         }
       } timer{eq, step_start, st.residual_evals, residuals_before};
-      if (eq.stop_requested()) {
-        out.status = RunStatus::interrupted(eq.stop().signal());
-        return out;
-      }
-      if (!emit.beat(t, st.steps)) {
-        out.status = emit.failure();
-        return out;
-      }
+      if (eq.stop_requested()) return RunStatus::interrupted(eq.stop().signal());
+      if (!emit.beat(t, st.steps)) return emit.failure();
       if (steps_this_output > o.max_steps)
         return fail("more than " + std::to_string(o.max_steps) + " steps in one output interval");
       // Rejected attempts count too: a step that never converges must not retry for ever.
@@ -287,11 +293,12 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
       ++attempts_this_output;
       if (!(h >= 1e-14 * std::max(1.0, t)))
         return fail(nonfinite || !std::isfinite(h) ? "non-finite values (NaN or inf) in the equations" : "step size underflow");
-      // Land exactly on the next breakpoint of the inputs and on t_end; stretch a step that would
-      // leave a sliver.
+      // Land exactly on the next breakpoint of the inputs, on the caller's `until` and on t_end;
+      // stretch a step that would leave a sliver.
       while (next_break < breaks.size() && breaks[next_break] <= t * (1 + 1e-14)) ++next_break;
-      const double t_stop = next_break < breaks.size() ? breaks[next_break] : o.t_end;
-      if (t + 1.05 * h >= t_stop) h = t_stop - t;
+      const double t_stop = std::min(next_break < breaks.size() ? breaks[next_break] : o.t_end, until);
+      const bool lands = t + 1.05 * h >= t_stop;
+      if (lands) h = t_stop - t;
       const double hg = h * T.gamma;
       weights(q, v, nullptr, nullptr);
 
@@ -357,6 +364,7 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
       }
 
       // Solution (stiffly accurate: the last stage) and error estimate.
+      VecX &q1 = Q, &v1 = V, &eqv = Qk, &evv = Vk;
       Q = Qk + (hg * hg) * alpha[s - 1];  // q1
       V = Vk + hg * alpha[s - 1];         // v1
       for (int j = 0; j < s; ++j) {
@@ -384,8 +392,9 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
         continue;
       }
 
-      // Accepted: outputs inside (t, t + h], then advance.
-      const double t1 = t + h;
+      // Accepted: outputs inside (t, t + h], then advance. A step that lands on a stop ends exactly
+      // there (t + (t_stop − t) rounds to t_stop but for the last bit; `until` must be met exactly).
+      const double t1 = lands ? t_stop : t + h;
       const VecX& a1 = alpha[s - 1];
       double Wd1 = Wd, Wi1 = Wi;
       for (int j = 0; j < s; ++j) {
@@ -397,10 +406,7 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
       ++steps_this_output;
       st.last_step = h;
       while (k_out <= n_out && t_output(k_out) <= t1 + 1e-12 * std::max(1.0, t1)) {
-        if (eq.stop_requested()) {  // a long step may cover many outputs
-          out.status = RunStatus::interrupted(eq.stop().signal());
-          return out;
-        }
+        if (eq.stop_requested()) return RunStatus::interrupted(eq.stop().signal());  // a long step may cover many outputs
         const double to = t_output(k_out);
         OutputSample smp;
         if (std::abs(to - t1) <= 1e-12 * std::max(1.0, t1)) {
@@ -421,11 +427,8 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
         }
         smp.steps = st.steps;
         smp.last_step = h;
-        if (!emit(smp)) {
-          out.status = emit.failure();
-          return out;
-        }
-        out.t_reached = to;
+        if (!emit(smp)) return emit.failure();
+        t_reached = to;
         ++k_out;
         steps_this_output = attempts_this_output = 0;
       }
@@ -437,39 +440,83 @@ RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, S
       Wd = Wd1;
       Wi = Wi1;
 
-      // Next step: PI controller (Gustafsson), no growth right after a rejection.
+      // Next step: PI controller (Gustafsson), no growth right after a rejection. A step cut short
+      // by the caller's `until` keeps the size the controller had in mind.
       double fac = kSafety * std::pow(err, -0.7 * expo) * std::pow(err_prev, 0.4 * expo);
       fac = std::clamp(fac, kMinFactor, last_rejected ? 1.0 : kMaxFactor);
       err_prev = err;
       last_rejected = nonfinite = false;
       h = o.fixed_step > 0 ? o.fixed_step : h * fac;
       if (o.max_step > 0) h = std::min(h, o.max_step);
-      const bool saved = emit.checkpoint([&] {
-        IntegratorState x;
-        x.t = t;
-        x.h = h;
-        x.err_prev = err_prev;
-        x.eta = eta;
-        x.dissipated = Wd;
-        x.input_work = Wi;
-        x.power = P;
-        x.next_output = k_out;
-        x.stats = st;
-        x.q = q;
-        x.v = v;
-        x.a = a;
-        return x;
-      });
-      if (!saved) {
-        out.status = emit.failure();
-        return out;
-      }
+      if (!emit.checkpoint([&] { return state(); })) return emit.failure();
     }
   } catch (const std::exception& e) {
     return fail(e.what());
   }
-  out.status = RunStatus::completed();
-  out.t_reached = o.t_end;
+  if (k_out > n_out) {
+    t_reached = o.t_end;
+    return RunStatus::completed();
+  }
+  return RunStatus{};
+}
+
+EsdirkStepper::EsdirkStepper(EquationsOfMotion& eq, const IntegratorOptions& opts)
+    : impl_(std::make_unique<Impl>(eq, opts)) {}
+EsdirkStepper::~EsdirkStepper() = default;
+EsdirkStepper::EsdirkStepper(EsdirkStepper&&) noexcept = default;
+
+RunStatus EsdirkStepper::start(SampleEmitter& emit) {
+  RFEM_CHECK_ARGUMENT(!impl_->started, "the stepper has started already");
+  return impl_->start(emit);
+}
+
+RunStatus EsdirkStepper::advance(double until, SampleEmitter& emit) {
+  RFEM_CHECK_ARGUMENT(impl_->started, "start() first");
+  RFEM_CHECK_ARGUMENT(until >= impl_->t && until <= impl_->o.t_end, "until must lie in [t, t_end]");
+  return impl_->advance(until, emit);
+}
+
+void EsdirkStepper::inputs_changed() {
+  Impl& m = *impl_;
+  RFEM_CHECK_ARGUMENT(m.started, "start() first");
+  // The accelerations and powers at t from the new inputs (right limit): the next step's first
+  // stage and the outputs' interpolation start from them.
+  m.a = m.eq.accelerations(m.t, m.q.data(), m.v.data());
+  m.P = m.eq.residual(m.t, m.q.data(), m.v.data(), m.a.data(), m.r.data());
+  ++m.st.residual_evals;
+}
+
+double EsdirkStepper::time() const { return impl_->t; }
+double EsdirkStepper::t_reached() const { return impl_->t_reached; }
+const IntegratorStats& EsdirkStepper::stats() const { return impl_->st; }
+
+IntegratorState EsdirkStepper::state() const { return impl_->state(); }
+
+IntegratorState EsdirkStepper::Impl::state() const {
+  const Impl& m = *this;
+  IntegratorState x;
+  x.t = m.t;
+  x.h = m.h;
+  x.err_prev = m.err_prev;
+  x.eta = m.eta;
+  x.dissipated = m.Wd;
+  x.input_work = m.Wi;
+  x.power = m.P;
+  x.next_output = m.k_out;
+  x.stats = m.st;
+  x.q = m.q;
+  x.v = m.v;
+  x.a = m.a;
+  return x;
+}
+
+RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, SampleEmitter& emit) {
+  EsdirkStepper stepper(eq, o);
+  RunOutcome out;
+  out.status = stepper.start(emit);
+  if (out.status.kind == RunStatus::Kind::Running) out.status = stepper.advance(o.t_end, emit);
+  out.stats = stepper.stats();
+  out.t_reached = stepper.t_reached();
   return out;
 }
 
