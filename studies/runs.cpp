@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "rfem/core/check.hpp"
 #include "rfem/core/positions.hpp"
 #include "rfem/studies/checkpoints.hpp"
 #include "rfem/studies/inputs.hpp"
@@ -43,84 +44,39 @@ std::vector<std::string> RunSeries::names() const {
   return out;
 }
 
-namespace {
-
-RunResult run_one(const std::string& name, std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs,
-                  const Case& cs, const RunRequest& rq) {
-  RunResult s;
-  s.name = name;
-  s.model = model;
-  for (const MountedLink& L : model->links) s.peaks.push_back({L.name});
-  IntegratorOptions o = cs.sim.options;
-  o.parallel.threads = rq.threads;
-  const auto from = rq.resume.find(name);
-  const Checkpoint* checkpoint = from == rq.resume.end() ? nullptr : &from->second;
-  RunState resumed;
-  if (checkpoint) resumed = RunState::unpack(checkpoint->state, -1);
-  const RunInfo info{name, model, o, input_kinds(inputs), cs.sim.flexible_every, o.parallel.max_threads(), checkpoint};
+RunBook::RunBook(std::string name, std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs, const Case& cs,
+                 const RunRequest& rq, const IntegratorOptions& o, const Checkpoint* checkpoint, const RunState* resumed)
+    : rq_(rq), o_(o), model_(std::move(model)), validity_(std::make_unique<ValidityMonitor>(*model_)),
+      t0_(std::chrono::steady_clock::now()) {
+  RunResult& s = s_;
+  s.name = std::move(name);
+  s.model = model_;
+  for (const MountedLink& L : model_->links) s.peaks.push_back({L.name});
+  const RunInfo info{s.name, model_, o, input_kinds(inputs), cs.sim.flexible_every, o.parallel.max_threads(), checkpoint};
   for (RunObserver* obs : rq.observers) obs->begin(info);
-  if (checkpoint)
+  if (checkpoint) {
+    RFEM_CHECK_ARGUMENT(resumed != nullptr, "a checkpoint needs its unpacked state");
     for (RunObserver* obs : rq.observers)
       if (const std::string key = obs->state_key(); !key.empty()) {
-        const std::vector<double>* x = resumed.find(key);
-        if (!x) throw std::invalid_argument("run " + name + ": its checkpoint holds no state of " + key);
+        const std::vector<double>* x = resumed->find(key);
+        if (!x) throw std::invalid_argument("run " + s.name + ": its checkpoint holds no state of " + key);
         obs->restore(*x);
       }
+  }
   if (rq.keep_series) {
     s.series = std::make_shared<RunSeries>();
-    s.series->layout = run_layout(*model, cs.sim.flexible_every);
+    s.series->layout = run_layout(*model_, cs.sim.flexible_every);
     s.series->data.resize(s.series->layout.series.size());
     s.series->flexible.resize(s.series->layout.flexible.size());
   }
-  std::vector<std::vector<double>> rows;
-  double balance0 = NAN;
-  const Model& m = *model;
-  ValidityMonitor validity(m);
-  auto sink = [&](const OutputSample& x) {
-    for (RunObserver* obs : rq.observers) obs->sample(x);
-    if (RunSeries* ser = s.series.get()) {
-      sample_rows(m, ser->layout, x, rows);
-      for (size_t i = 0; i < rows.size(); ++i) ser->data[i].insert(ser->data[i].end(), rows[i].begin(), rows[i].end());
-      if (!ser->layout.flexible.empty() && ser->rows % ser->layout.flexible_every == 0) {
-        flexible_rows(m, ser->layout, x, rows);
-        for (size_t i = 0; i < rows.size(); ++i) ser->flexible[i].insert(ser->flexible[i].end(), rows[i].begin(), rows[i].end());
-        ++ser->flexible_rows;
-      }
-      ++ser->rows;
-    }
-    for (size_t l = 0; l < s.peaks.size(); ++l) {
-      const Vec3 u = tip_deflection(m, static_cast<int>(l), x.q);
-      LinkPeaks& pk = s.peaks[l];
-      pk.u1 = std::max(pk.u1, std::abs(u[0]));
-      pk.u2 = std::max(pk.u2, std::abs(u[1]));
-      pk.theta = std::max(pk.theta, std::abs(u[2]));
-    }
-    validity.check(x.q, x.t);
-    validity.check_joints(x.q, x.v, x.tau, x.t);
-    const double bal = x.energy_balance();
-    if (std::isnan(balance0)) balance0 = bal;
-    s.energy_drift = std::max(s.energy_drift, std::abs(bal - balance0));
-    s.energy_scale = std::max({s.energy_scale, x.energy.kinetic, std::abs(x.energy.elastic), std::abs(x.input_work)});
-    ++s.samples;
-  };
-  // The run's own summary in a checkpoint, and back.
-  double wall_before = 0.0;
-  auto summary = [&](double wall) {
-    std::vector<double> x = {static_cast<double>(s.samples), wall, balance0, s.energy_drift, s.energy_scale,
-                             static_cast<double>(s.peaks.size())};
-    for (const LinkPeaks& pk : s.peaks) x.insert(x.end(), {pk.u1, pk.u2, pk.theta});
-    const std::vector<double> v = validity.save();
-    x.insert(x.end(), v.begin(), v.end());
-    return x;
-  };
-  if (checkpoint) {
-    const std::vector<double>& x = resumed.summary;
+  if (checkpoint) {  // the run's own summary (summary()), back
+    const std::vector<double>& x = resumed->summary;
     const size_t links = s.peaks.size();
     if (x.size() < 6 + 3 * links || x[5] != static_cast<double>(links))
-      throw std::invalid_argument("run " + name + ": its checkpoint is not of this model");
+      throw std::invalid_argument("run " + s.name + ": its checkpoint is not of this model");
     s.samples = static_cast<long>(x[0]);
-    wall_before = x[1];
-    balance0 = x[2];
+    wall_before_ = x[1];
+    balance0_ = x[2];
     s.energy_drift = x[3];
     s.energy_scale = x[4];
     for (size_t l = 0; l < links; ++l) {
@@ -128,49 +84,109 @@ RunResult run_one(const std::string& name, std::shared_ptr<const Model> model, c
       s.peaks[l].u2 = x[7 + 3 * l];
       s.peaks[l].theta = x[8 + 3 * l];
     }
-    validity.restore(std::vector<double>(x.begin() + static_cast<long>(6 + 3 * links), x.end()));
-    if (checkpoint->rows != s.samples) throw std::invalid_argument("run " + name + ": its checkpoint is damaged (rows)");
+    validity_->restore(std::vector<double>(x.begin() + static_cast<long>(6 + 3 * links), x.end()));
+    if (checkpoint->rows != s.samples) throw std::invalid_argument("run " + s.name + ": its checkpoint is damaged (rows)");
   }
+}
+
+RunBook::~RunBook() = default;
+
+void RunBook::sample(const OutputSample& x) {
+  RunResult& s = s_;
+  const Model& m = *model_;
+  for (RunObserver* obs : rq_.observers) obs->sample(x);
+  if (RunSeries* ser = s.series.get()) {
+    sample_rows(m, ser->layout, x, rows_);
+    for (size_t i = 0; i < rows_.size(); ++i) ser->data[i].insert(ser->data[i].end(), rows_[i].begin(), rows_[i].end());
+    if (!ser->layout.flexible.empty() && ser->rows % ser->layout.flexible_every == 0) {
+      flexible_rows(m, ser->layout, x, rows_);
+      for (size_t i = 0; i < rows_.size(); ++i) ser->flexible[i].insert(ser->flexible[i].end(), rows_[i].begin(), rows_[i].end());
+      ++ser->flexible_rows;
+    }
+    ++ser->rows;
+  }
+  for (size_t l = 0; l < s.peaks.size(); ++l) {
+    const Vec3 u = tip_deflection(m, static_cast<int>(l), x.q);
+    LinkPeaks& pk = s.peaks[l];
+    pk.u1 = std::max(pk.u1, std::abs(u[0]));
+    pk.u2 = std::max(pk.u2, std::abs(u[1]));
+    pk.theta = std::max(pk.theta, std::abs(u[2]));
+  }
+  validity_->check(x.q, x.t);
+  validity_->check_joints(x.q, x.v, x.tau, x.t);
+  const double bal = x.energy_balance();
+  if (std::isnan(balance0_)) balance0_ = bal;
+  s.energy_drift = std::max(s.energy_drift, std::abs(bal - balance0_));
+  s.energy_scale = std::max({s.energy_scale, x.energy.kinetic, std::abs(x.energy.elastic), std::abs(x.input_work)});
+  ++s.samples;
+}
+
+double RunBook::wall() const {
+  return wall_before_ + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+}
+
+void RunBook::checkpoint(const IntegratorState& st) {
+  // The run's own summary, then every observer's state.
+  const RunResult& s = s_;
+  RunState x;
+  x.integrator = st;
+  x.summary = {static_cast<double>(s.samples), wall(), balance0_, s.energy_drift, s.energy_scale, static_cast<double>(s.peaks.size())};
+  for (const LinkPeaks& pk : s.peaks) x.summary.insert(x.summary.end(), {pk.u1, pk.u2, pk.theta});
+  const std::vector<double> v = validity_->save();
+  x.summary.insert(x.summary.end(), v.begin(), v.end());
+  for (RunObserver* obs : rq_.observers)
+    if (const std::string key = obs->state_key(); !key.empty()) x.add(key, obs->save());
+  const std::vector<double> packed = x.pack();
+  for (RunObserver* obs : rq_.observers) obs->checkpoint(packed);
+}
+
+RunResult RunBook::end(RunOutcome r) {
+  RunResult& s = s_;
+  // Progress once more where the run ended, so every run reports at least once however short it is
+  // (a caller's answer must not depend on wall time); a throwing callback fails a completed run.
+  if (rq_.progress && r.t_reached > 0) {
+    try {
+      rq_.progress({s.name, r.t_reached, o_.t_end, r.stats.steps});
+    } catch (const std::exception& e) {
+      if (r.status.is_completed()) r.status = RunStatus::failed(e.what());
+    }
+  }
+  s.wall_s = wall();
+  s.status = r.status;
+  s.stats = r.stats;
+  s.t_reached = r.t_reached;
+  s.warnings = validity_->warnings("run " + s.name);
+  if (rq_.warn)
+    for (const auto& w : s.warnings) rq_.warn(w);
+  for (RunObserver* obs : rq_.observers) obs->end(s);
+  return s;
+}
+
+namespace {
+
+RunResult run_one(const std::string& name, std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs,
+                  const Case& cs, const RunRequest& rq) {
+  IntegratorOptions o = cs.sim.options;
+  o.parallel.threads = rq.threads;
+  const auto from = rq.resume.find(name);
+  const Checkpoint* checkpoint = from == rq.resume.end() ? nullptr : &from->second;
+  RunState resumed;
+  if (checkpoint) resumed = RunState::unpack(checkpoint->state, -1);
+  RunBook book(name, model, inputs, cs, rq, o, checkpoint, &resumed);
   RunControl control;
   control.stop = rq.stop;
   control.resume = checkpoint ? &resumed.integrator : nullptr;
   control.checkpoint_interval = rq.checkpoint_interval;
   control.heartbeat_interval = rq.progress_interval;
   if (rq.progress) control.heartbeat = [&](double t, long steps) { rq.progress({name, t, o.t_end, steps}); };
-  const auto t0 = std::chrono::steady_clock::now();
-  control.checkpoint = [&](const IntegratorState& st) {
-    RunState x;
-    x.integrator = st;
-    x.summary = summary(wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    for (RunObserver* obs : rq.observers)
-      if (const std::string key = obs->state_key(); !key.empty()) x.add(key, obs->save());
-    const std::vector<double> packed = x.pack();
-    for (RunObserver* obs : rq.observers) obs->checkpoint(packed);
-  };
+  control.checkpoint = [&](const IntegratorState& st) { book.checkpoint(st); };
   RunOutcome r;
   try {
-    r = integrate(model, inputs, o, sink, control);
+    r = integrate(model, inputs, o, [&](const OutputSample& x) { book.sample(x); }, control);
   } catch (const std::exception& e) {  // (bad options or inputs): the run's record says why
     r.status = RunStatus::failed(e.what());
   }
-  // Progress once more where the run ended, so every run reports at least once however short it is
-  // (a caller's answer must not depend on wall time); a throwing callback fails a completed run.
-  if (rq.progress && r.t_reached > 0) {
-    try {
-      rq.progress({name, r.t_reached, o.t_end, r.stats.steps});
-    } catch (const std::exception& e) {
-      if (r.status.is_completed()) r.status = RunStatus::failed(e.what());
-    }
-  }
-  s.wall_s = wall_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  s.status = r.status;
-  s.stats = r.stats;
-  s.t_reached = r.t_reached;
-  s.warnings = validity.warnings("run " + name);
-  if (rq.warn)
-    for (const auto& w : s.warnings) rq.warn(w);
-  for (RunObserver* obs : rq.observers) obs->end(s);
-  return s;
+  return book.end(r);
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 // (results/layout.hpp) — and stream to any observers while the runs go (an HDF5 file through
 // studies/recorders.hpp). A stop token ends a run cleanly within a step; progress goes to a
 // callback; warnings are returned, never printed.
+#include <chrono>
+#include <cmath>
 #include <functional>
 #include <map>
 #include <memory>
@@ -126,6 +128,45 @@ struct RunRequest {
   /// run again, and the checkpoints the others resume from.
   std::vector<std::string> done;
   std::map<std::string, Checkpoint> resume;
+};
+
+struct RunState;
+class ValidityMonitor;
+
+/// The bookkeeping of one run as its outputs arrive — the observers, the series kept in memory,
+/// peaks, the energy balance's drift, the validity warnings, checkpoints of all that, the final
+/// progress report: what run_case does around its integrator, shared with a simulation that a
+/// caller steps (studies/simulation.hpp). The request (observers, callbacks) outlives the book.
+class RunBook {
+ public:
+  /// Tells the observers that the run begins; resuming (`checkpoint` and its unpacked `resumed`),
+  /// restores the run's summary and the observers' state (std::invalid_argument for another model's).
+  RunBook(std::string name, std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs, const Case& cs,
+          const RunRequest& rq, const IntegratorOptions& o, const Checkpoint* checkpoint = nullptr,
+          const RunState* resumed = nullptr);
+  ~RunBook();
+  RunBook(const RunBook&) = delete;
+  RunBook& operator=(const RunBook&) = delete;
+  /// An output step: to the observers and the books (a throwing observer's message fails the run).
+  void sample(const OutputSample& x);
+  /// A checkpoint of the integrator's state with the books' and the observers' states, handed to
+  /// the observers (the results file keeps it).
+  void checkpoint(const IntegratorState& st);
+  /// Ends the run with the integrator's outcome: the result, also given to the observers.
+  RunResult end(RunOutcome r);
+  /// The result so far (status Running).
+  const RunResult& result() const { return s_; }
+
+ private:
+  double wall() const;
+  const RunRequest& rq_;
+  IntegratorOptions o_;
+  std::shared_ptr<const Model> model_;
+  RunResult s_;
+  std::unique_ptr<ValidityMonitor> validity_;
+  std::vector<std::vector<double>> rows_;
+  double balance0_ = NAN, wall_before_ = 0.0;
+  std::chrono::steady_clock::time_point t0_;
 };
 
 /// CaseError unless the case can be run: a [simulation] table and at least one joint.
