@@ -87,11 +87,11 @@ void apply_override(toml::table& root, const std::string& file, const std::strin
 }
 
 
-Simulation read_simulation(const Reader& r, const toml::table& t) {
+SimulationSettings read_simulation(const Reader& r, const toml::table& t) {
   const std::string p = "simulation";
   r.check_keys(t, p, {"t_end", "output_dt", "rtol", "atol", "atol_velocity", "max_step", "procedure", "store_flexible_every",
                       "max_order", "max_steps", "integrator", "method", "initial"});
-  Simulation s;
+  SimulationSettings s;
   IntegratorOptions& o = s.options;
   o.t_end = r.positive(t, p, "t_end");
   o.output_dt = r.positive(t, p, "output_dt", std::min(o.output_dt, o.t_end));

@@ -44,7 +44,7 @@ struct InputSpec {
 
 /// The `[simulation]` table: the integrator's settings (their defaults are IntegratorOptions') and
 /// what to run and store.
-struct Simulation {
+struct SimulationSettings {
   IntegratorOptions options;
   Procedure procedure = Procedure::Single;  ///< single, or paper (rigid inverse dynamics, kinematic, force input)
   int flexible_every = 0;            ///< store the full flexible state every k outputs (0: never)
@@ -91,7 +91,7 @@ struct Case {
   double gravity = 0.0;
   TipLoads loads;                  ///< on the link [loads] names (the last by default)
   std::vector<InputSpec> inputs;  ///< one per joint
-  Simulation sim;
+  SimulationSettings sim;
   bool has_simulation = false;
 };
 

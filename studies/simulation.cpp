@@ -1,0 +1,487 @@
+#include "rfem/studies/simulation.hpp"
+
+#include <cmath>
+#include <deque>
+#include <stdexcept>
+
+#include "rfem/core/check.hpp"
+#include "rfem/core/positions.hpp"
+#include "rfem/results/errors.hpp"
+#include "rfem/results/writer.hpp"
+#include "rfem/solvers/esdirk_stepper.hpp"
+#include "rfem/studies/common.hpp"
+#include "rfem/studies/inputs.hpp"
+#include "rfem/studies/recorders.hpp"
+
+namespace rfem {
+
+namespace {
+
+constexpr double kStateVersion = 1.0;
+// What a joint holds (SimulationState::drives: the mode, then τ, q_ref, q̇_ref, τ_ff).
+constexpr int kHeldNone = 0, kHeldTorque = 1, kHeldReference = 2, kDriveValues = 5;
+
+// A force-input joint's law with a value the caller may hold instead (zero-order hold): a torque,
+// or a PD reference with the case's gains. The Newton matrix keeps the case law's feedback gains
+// (its stiffness and damping): they only speed the Newton iteration up, the solution is the law's.
+class HeldLaw : public TorqueLaw {
+ public:
+  explicit HeldLaw(std::shared_ptr<TorqueLaw> base) : base_(std::move(base)) {}
+  double at(double t) const override {
+    return mode == kHeldTorque ? tau : mode == kHeldReference ? tau_ff : base_->at(t);
+  }
+  double at(double t, double q, double v) const override {
+    if (mode == kHeldTorque) return tau;
+    if (mode == kHeldReference) return tau_ff + base_->stiffness() * (q_ref - q) + base_->damping() * (v_ref - v);
+    return base_->at(t, q, v);
+  }
+  double stiffness() const override { return base_->stiffness(); }
+  double damping() const override { return base_->damping(); }
+  std::vector<double> breakpoints() const override { return base_->breakpoints(); }
+  bool feedback() const { return base_->stiffness() > 0 || base_->damping() > 0; }
+  int mode = kHeldNone;
+  double tau = 0.0, q_ref = 0.0, v_ref = 0.0, tau_ff = 0.0;
+
+ private:
+  std::shared_ptr<TorqueLaw> base_;
+};
+
+const char* kAxisNames[6] = {"x1", "x2", "x3", "phi1", "phi2", "phi3"};
+
+}  // namespace
+
+std::vector<double> SimulationState::pack() const {
+  std::vector<double> x = {kStateVersion, static_cast<double>(drives.size())};
+  x.insert(x.end(), drives.begin(), drives.end());
+  const std::vector<double> i = integrator.pack();
+  x.insert(x.end(), i.begin(), i.end());
+  return x;
+}
+
+SimulationState SimulationState::unpack(const std::string& model, const std::vector<double>& x) {
+  if (x.size() < 2 || x[0] != kStateVersion || !(x[1] >= 0) || x[1] != std::floor(x[1]) ||
+      x.size() < 2 + static_cast<size_t>(x[1]))
+    throw std::invalid_argument("not a simulation state of this version of rfem");
+  SimulationState s;
+  s.model = model;
+  const size_t nd = static_cast<size_t>(x[1]);
+  s.drives.assign(x.begin() + 2, x.begin() + 2 + static_cast<long>(nd));
+  s.integrator = IntegratorState::unpack(std::vector<double>(x.begin() + 2 + static_cast<long>(nd), x.end()), -1);
+  return s;
+}
+
+std::string model_signature(const Model& model, const std::vector<JointInput>& inputs) {
+  std::string s = "n=" + std::to_string(model.n()) + "; links=";
+  for (size_t l = 0; l < model.links.size(); ++l)
+    s += (l ? "," : "") + model.links[l].name + ":" + std::to_string(model.links[l].n());
+  s += "; joints=";
+  const std::vector<std::string> kinds = input_kinds(inputs);
+  for (int j = 0; j < model.m(); ++j)
+    s += (j ? "," : "") + model.joints[j].name + ":" + (model.joints[j].type == JointType::Revolute ? "revolute" : "prismatic") +
+         ":" + kinds[j];
+  return s;
+}
+
+void save_state(const SimulationState& state, const std::string& path) {
+  FileDescription d;
+  d.command_line = "rfem simulation state at t = " + std::to_string(state.time()) + " s";
+  d.procedure = "state";
+  ResultsWriter w(path, d);
+  const std::vector<double> x = state.pack();
+  w.write_table("state/packed", Table{static_cast<long>(x.size()), 1, x}, {"value"}, {""},
+                "a simulation's state (studies/simulation.hpp: SimulationState::pack)");
+  w.write_attribute("state", "model", state.model);
+  w.close();
+}
+
+SimulationState load_state(const std::string& path) {
+  const ResultsReader in(path);
+  const std::string model = in.attribute("state", "model");
+  if (model.empty()) throw std::invalid_argument(path + ": no simulation state in it (state/model)");
+  try {
+    return SimulationState::unpack(model, in.table("state/packed").data);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(path + ": " + e.what());
+  }
+}
+
+struct Simulation::Impl {
+  Case cs;
+  SimulationOptions opts;
+  IntegratorOptions o;
+  std::shared_ptr<const Model> model;
+  std::vector<JointInput> inputs;
+  std::vector<std::shared_ptr<HeldLaw>> held;  // per joint (null: prescribed motion)
+  std::string signature;
+  std::unique_ptr<ResultsWriter> file;
+  std::unique_ptr<Hdf5Recorder> recorder;
+  RunRequest rq;
+  std::unique_ptr<RunBook> book;
+  std::unique_ptr<EquationsOfMotion> eq;
+  std::unique_ptr<EsdirkStepper> stepper;  // (after eq: it refers to it)
+  SampleSink sink;
+  RunControl control;
+  IntegratorState resume;
+  std::unique_ptr<SampleEmitter> emit;  // (after sink and control: it refers to them)
+  RunStatus status;
+  bool changed = false;  // a held value changed since the last step
+  std::optional<RunResult> result;
+  struct PendingTable {
+    std::string name;
+    Table table;
+    std::vector<std::string> columns, units;
+    std::string description;
+  };
+  std::vector<PendingTable> tables;
+
+  int joint(const std::string& name) const {
+    for (int j = 0; j < model->m(); ++j)
+      if (model->joints[j].name == name) return j;
+    std::string names;
+    for (const Joint& J : model->joints) names += (names.empty() ? "" : ", ") + J.name;
+    throw std::invalid_argument("no joint named '" + name + "' (joints: " + names + ")");
+  }
+  HeldLaw& law(const std::string& name, const char* what) {
+    const int j = joint(name);
+    if (!held[j])
+      throw std::invalid_argument("joint '" + name + "' follows a prescribed motion: " + what +
+                                  " needs a force-input joint (its torque is an output here)");
+    return *held[j];
+  }
+  void apply_drives(const std::vector<double>& d) {
+    if (d.size() != static_cast<size_t>(kDriveValues * model->m()))
+      throw std::invalid_argument("the state's drives do not fit this model");
+    for (int j = 0; j < model->m(); ++j) {
+      const double* x = d.data() + kDriveValues * j;
+      if (!held[j]) continue;
+      held[j]->mode = static_cast<int>(x[0]);
+      held[j]->tau = x[1];
+      held[j]->q_ref = x[2];
+      held[j]->v_ref = x[3];
+      held[j]->tau_ff = x[4];
+    }
+  }
+  void bring_inputs_up_to_date() {
+    if (!changed || status.kind != RunStatus::Kind::Running) return;
+    stepper->inputs_changed();
+    changed = false;
+  }
+  void require_running(const char* what) const {
+    if (result) throw std::logic_error(std::string(what) + ": the simulation has finished (" + result->status.to_string() + ")");
+  }
+};
+
+Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  check_runnable(cs);
+  if (cs.sim.options.kind != IntegratorKind::Esdirk)
+    throw CaseError(cs.path + ": simulation.integrator: a simulation that is stepped integrates with \"esdirk\" "
+                              "(IDA's BDF history cannot be handed over)");
+  m.cs = cs;
+  m.opts = std::move(opts);
+  m.o = cs.sim.options;
+  m.o.parallel.threads = m.opts.threads;
+  m.model = model_of(cs, m.opts.n);
+  m.inputs = rfem::joint_inputs(cs, m.opts.warn);
+  m.signature = model_signature(*m.model, m.inputs);
+  m.held.resize(m.inputs.size());
+  for (size_t j = 0; j < m.inputs.size(); ++j)
+    if (!m.inputs[j].prescribed()) {
+      m.held[j] = std::make_shared<HeldLaw>(m.inputs[j].torque);
+      m.inputs[j].torque = m.held[j];
+    }
+  const SimulationState* from = m.opts.state.get();
+  if (from) {
+    if (from->model != m.signature)
+      throw std::invalid_argument("the state is of another model: it has " + from->model + "; this simulation " + m.signature);
+    if (!(from->time() >= 0 && from->time() < m.o.t_end))
+      throw std::invalid_argument("the state's time " + std::to_string(from->time()) + " s is not before simulation.t_end = " +
+                                  std::to_string(m.o.t_end) + " s");
+    m.apply_drives(from->drives);
+    m.resume = from->integrator;
+    m.resume.stats = {};
+    // The outputs after the state's time, on this run's grid (the state's own row is written below).
+    const double t = from->time();
+    long k = static_cast<long>(std::floor(t / m.o.output_dt)) + 1;
+    while (k > 1 && output_time(m.o, k - 1) > t) --k;
+    m.resume.next_output = std::min(k, output_count(m.o) + 1);
+    m.control.resume = &m.resume;
+  }
+  if (!m.opts.output.empty()) {
+    Parallelism p;
+    p.threads = m.opts.threads;
+    try {
+      m.file = std::make_unique<ResultsWriter>(
+          m.opts.output, describe(cs, m.opts.made_by, "single", m.model->n(), p.max_threads(), m.opts.n));
+    } catch (const ResultsError& e) {  // the caller's path: bad input
+      throw CaseError(e.what());
+    }
+    m.recorder = std::make_unique<Hdf5Recorder>(*m.file);
+    m.rq.observers.push_back(m.recorder.get());
+  }
+  m.rq.observers.insert(m.rq.observers.end(), m.opts.observers.begin(), m.opts.observers.end());
+  m.rq.n = m.opts.n;
+  m.rq.threads = m.opts.threads;
+  m.rq.keep_series = m.opts.keep_series;
+  m.rq.warn = m.opts.warn;
+  m.rq.stop = m.opts.stop;
+  m.rq.checkpoint_interval = 0.0;  // (`rfem run --resume` would go on without the caller's hand)
+  m.book = std::make_unique<RunBook>("run", m.model, m.inputs, cs, m.rq, m.o);
+  m.eq = std::make_unique<EquationsOfMotion>(m.model, m.inputs, m.o.forces, m.rq.stop, m.o.linear_solver, m.o.parallel);
+  if (m.eq->unknowns() == 0)
+    throw CaseError(cs.path + ": joints: every joint follows a prescribed motion and there is no flexible link: nothing to step "
+                              "(rfem run computes its torques)");
+  m.stepper = std::make_unique<EsdirkStepper>(*m.eq, m.o);
+  m.sink = [&m](const OutputSample& x) { m.book->sample(x); };
+  m.control.stop = m.rq.stop;
+  m.emit = std::make_unique<SampleEmitter>(m.sink, m.control);
+  try {
+    m.status = m.stepper->start(*m.emit);
+    if (from && m.status.kind == RunStatus::Kind::Running) {  // the state's own row
+      const IntegratorState& x = m.resume;
+      if (!(*m.emit)(m.eq->sample(x.t, x.q.data(), x.v.data(), x.a.data(), x.dissipated, x.input_work)))
+        m.status = m.emit->failure();
+    }
+  } catch (const std::invalid_argument&) {
+    throw;  // a state that does not fit
+  } catch (const std::exception& e) {
+    m.status = RunStatus::failed(at_start(e.what()));
+  }
+}
+
+Simulation::~Simulation() {
+  if (!impl_ || impl_->result) return;
+  try {
+    finish();
+  } catch (...) {  // (a destructor reports nothing; finish() is the caller's way to hear of it)
+  }
+}
+
+Simulation::Simulation(Simulation&&) noexcept = default;
+
+const Model& Simulation::model() const { return *impl_->model; }
+std::shared_ptr<const Model> Simulation::shared_model() const { return impl_->model; }
+double Simulation::time() const { return impl_->stepper->time(); }
+double Simulation::t_end() const { return impl_->o.t_end; }
+
+VecX Simulation::q() const {
+  const Impl& m = *impl_;
+  const IntegratorState x = m.stepper->state();
+  VecX q = VecX::Zero(m.model->dof());
+  for (int i = 0; i < m.eq->unknowns(); ++i) q[m.eq->unknown_index(i)] = x.q[i];
+  for (int j = 0; j < m.model->m(); ++j)
+    if (m.inputs[j].prescribed()) q[m.model->joint_index(j)] = m.inputs[j].motion->at(x.t).q;
+  return q;
+}
+
+VecX Simulation::v() const {
+  const Impl& m = *impl_;
+  const IntegratorState x = m.stepper->state();
+  VecX v = VecX::Zero(m.model->dof());
+  for (int i = 0; i < m.eq->unknowns(); ++i) v[m.eq->unknown_index(i)] = x.v[i];
+  for (int j = 0; j < m.model->m(); ++j)
+    if (m.inputs[j].prescribed()) v[m.model->joint_index(j)] = m.inputs[j].motion->at(x.t).qd;
+  return v;
+}
+
+std::vector<std::string> Simulation::coordinate_names() const {
+  const Model& md = *impl_->model;
+  std::vector<std::string> names(md.dof());
+  for (size_t l = 0; l < md.links.size(); ++l)
+    for (int k = 0; k < md.links[l].n(); ++k)
+      for (int a = 0; a < Model::rfe_dofs; ++a)
+        names[md.rfe_index(static_cast<int>(l), k) + a] = md.links[l].name + "/rfe" + std::to_string(k + 1) + "/" + kAxisNames[a];
+  for (int j = 0; j < md.m(); ++j) names[md.joint_index(j)] = md.joints[j].name;
+  return names;
+}
+
+std::vector<std::string> Simulation::joint_names() const {
+  std::vector<std::string> names;
+  for (const Joint& j : impl_->model->joints) names.push_back(j.name);
+  return names;
+}
+
+std::vector<std::string> Simulation::joint_inputs() const { return input_kinds(impl_->inputs); }
+
+void Simulation::set_torque(const std::string& joint, double tau) {
+  Impl& m = *impl_;
+  HeldLaw& law = m.law(joint, "set_torque");
+  if (!std::isfinite(tau)) throw std::invalid_argument("set_torque: joint '" + joint + "': the torque must be finite");
+  law.mode = kHeldTorque;
+  law.tau = tau;
+  m.changed = true;
+}
+
+void Simulation::set_reference(const std::string& joint, double q_ref, double v_ref, double tau_ff) {
+  Impl& m = *impl_;
+  HeldLaw& law = m.law(joint, "set_reference");
+  if (!law.feedback())
+    throw std::invalid_argument("set_reference: joint '" + joint + "' has no PD law in the case (input kind \"pd\"): "
+                                "hold a torque with set_torque");
+  if (!std::isfinite(q_ref) || !std::isfinite(v_ref) || !std::isfinite(tau_ff))
+    throw std::invalid_argument("set_reference: joint '" + joint + "': the reference must be finite");
+  law.mode = kHeldReference;
+  law.q_ref = q_ref;
+  law.v_ref = v_ref;
+  law.tau_ff = tau_ff;
+  m.changed = true;
+}
+
+void Simulation::release(const std::string& joint) {
+  Impl& m = *impl_;
+  m.law(joint, "release").mode = kHeldNone;
+  m.changed = true;
+}
+
+RunStatus Simulation::advance(double t) {
+  Impl& m = *impl_;
+  m.require_running("advance");
+  const double now = time();
+  if (!std::isfinite(t) || t < now || t > m.o.t_end)
+    throw std::invalid_argument("advance: t = " + std::to_string(t) + " s must lie between the simulation's time " +
+                                std::to_string(now) + " s and simulation.t_end = " + std::to_string(m.o.t_end) + " s");
+  if (m.status.kind != RunStatus::Kind::Running || t == now) return m.status;
+  try {
+    m.bring_inputs_up_to_date();
+    m.status = m.stepper->advance(t, *m.emit);
+  } catch (const std::exception& e) {
+    m.status = RunStatus::failed(e.what());
+  }
+  return m.status;
+}
+
+Snapshot Simulation::snapshot() {
+  Impl& m = *impl_;
+  m.require_running("snapshot");
+  m.bring_inputs_up_to_date();
+  const IntegratorState x = m.stepper->state();
+  const OutputSample s = m.eq->sample(x.t, x.q.data(), x.v.data(), x.a.data(), x.dissipated, x.input_work);
+  Snapshot y;
+  y.t = x.t;
+  y.joint_q = m.model->joint_coords(s.q);
+  y.joint_v = m.model->joint_coords(s.v);
+  y.joint_tau = s.tau;
+  for (size_t l = 0; l < m.model->links.size(); ++l) {
+    y.tip_position.push_back(tip_motion(*m.model, static_cast<int>(l), s.q).head<3>());
+    y.tip_deflection.push_back(tip_deflection(*m.model, static_cast<int>(l), s.q));
+  }
+  return y;
+}
+
+SimulationState Simulation::state() const {
+  const Impl& m = *impl_;
+  SimulationState s;
+  s.model = m.signature;
+  s.integrator = m.stepper->state();
+  s.drives.assign(static_cast<size_t>(kDriveValues * m.model->m()), 0.0);
+  for (int j = 0; j < m.model->m(); ++j)
+    if (const HeldLaw* h = m.held[j].get()) {
+      double* d = s.drives.data() + kDriveValues * j;
+      d[0] = h->mode;
+      d[1] = h->tau;
+      d[2] = h->q_ref;
+      d[3] = h->v_ref;
+      d[4] = h->tau_ff;
+    }
+  return s;
+}
+
+RunResult Simulation::finish(std::optional<RunStatus> status) {
+  Impl& m = *impl_;
+  if (m.result) return *m.result;
+  RunOutcome r;
+  r.status = status ? *status : m.status;
+  if (r.status.kind == RunStatus::Kind::Running)
+    r.status = time() >= m.o.t_end ? RunStatus::completed() : RunStatus::interrupted(0);
+  if (r.status.kind == RunStatus::Kind::Completed && time() < m.o.t_end) r.status = RunStatus::interrupted(0);
+  r.t_reached = m.stepper ? m.stepper->t_reached() : 0.0;
+  r.stats = m.stepper ? m.stepper->stats() : IntegratorStats{};
+  m.status = r.status;
+  m.result = m.book->end(r);
+  if (m.file) {
+    for (const Impl::PendingTable& t : m.tables)
+      m.file->write_table("run/" + t.name, t.table, t.columns, t.units, t.description);
+    m.file->close();
+    write_views(m.cs, *m.model, m.opts.output, m.opts.warn);
+  }
+  return *m.result;
+}
+
+bool Simulation::finished() const { return impl_->result.has_value(); }
+RunStatus Simulation::status() const { return impl_->status; }
+const std::string& Simulation::output() const { return impl_->opts.output; }
+
+void Simulation::record_table(const std::string& name, const Table& table, const std::vector<std::string>& columns,
+                              const std::vector<std::string>& units, const std::string& description) {
+  Impl& m = *impl_;
+  m.require_running("record_table");
+  RFEM_CHECK_ARGUMENT_SIZE(table.data.size(), table.rows * table.cols, "table");
+  RFEM_CHECK_ARGUMENT_SIZE(columns.size(), table.cols, "columns");
+  m.tables.push_back({name, table, columns, units, description});
+}
+
+RunResult run_controlled(const Case& cs, SimulationOptions opts, const Controller& controller, const ControlOptions& c) {
+  RFEM_CHECK_ARGUMENT(static_cast<bool>(controller), "no controller");
+  if (!(c.sample_time > 0) || !std::isfinite(c.sample_time))
+    throw std::invalid_argument("sample_time must be a positive number of seconds (got " + std::to_string(c.sample_time) + ")");
+  if (c.sample_time > cs.sim.options.t_end)
+    throw std::invalid_argument("sample_time = " + std::to_string(c.sample_time) + " s is longer than the run (simulation.t_end = " +
+                                std::to_string(cs.sim.options.t_end) + " s)");
+  if (c.delay < 0) throw std::invalid_argument("delay must be a whole number of samples ≥ 0 (got " + std::to_string(c.delay) + ")");
+  Simulation sim(cs, std::move(opts));
+  const Model& md = sim.model();
+  const std::vector<std::string> kinds = sim.joint_inputs();
+  // The record: per sample, the time and each force-input joint's held torque or reference (NaN:
+  // the case's law).
+  std::vector<std::string> columns = {"time"}, units = {"s"};
+  std::vector<int> recorded;
+  for (int j = 0; j < md.m(); ++j)
+    if (kinds[j] != "motion") {
+      columns.push_back(md.joints[j].name);
+      units.push_back(kinds[j] == "feedback" ? "q_ref or N m" : "N m or N");
+      recorded.push_back(j);
+    }
+  Table record{0, static_cast<long>(columns.size()), {}};
+  std::vector<double> now(recorded.size(), NAN);
+  auto finish = [&](std::optional<RunStatus> s) {
+    sim.record_table("control", record, columns, units,
+                     "the controller's outputs in effect from each sample time (zero-order hold; NaN: the case's law)");
+    return sim.finish(s);
+  };
+  std::deque<ControlOutput> pending;
+  const double t_end = sim.t_end();
+  for (long k = 0;; ++k) {
+    const double tk = k * c.sample_time;
+    if (tk >= t_end * (1 - 1e-12) || sim.status().kind != RunStatus::Kind::Running) break;
+    ControlOutput u;
+    try {
+      u = controller(tk, sim.snapshot());
+      for (const auto& [name, tau] : u.torques)
+        if (!std::isfinite(tau)) throw std::invalid_argument("joint '" + name + "': torque " + std::to_string(tau) + " is not finite");
+      for (const auto& [name, r] : u.references)
+        if (!std::isfinite(r.q) || !std::isfinite(r.v) || !std::isfinite(r.tau_ff))
+          throw std::invalid_argument("joint '" + name + "': the reference is not finite");
+      pending.push_back(std::move(u));
+      if (pending.size() > static_cast<size_t>(c.delay)) {
+        const ControlOutput& out = pending.front();
+        for (const auto& [name, tau] : out.torques) sim.set_torque(name, tau);
+        for (const auto& [name, r] : out.references) sim.set_reference(name, r.q, r.v, r.tau_ff);
+        for (size_t i = 0; i < recorded.size(); ++i) {
+          const std::string& name = md.joints[recorded[i]].name;
+          if (const auto it = out.torques.find(name); it != out.torques.end()) now[i] = it->second;
+          if (const auto it = out.references.find(name); it != out.references.end()) now[i] = it->second.q;
+        }
+        pending.pop_front();
+      }
+    } catch (const std::exception& e) {
+      return finish(RunStatus::failed(std::string("controller: ") + e.what() + " at t = " + std::to_string(tk) + " s"));
+    }
+    record.data.push_back(tk);
+    record.data.insert(record.data.end(), now.begin(), now.end());
+    ++record.rows;
+    sim.advance(std::min((k + 1) * c.sample_time, t_end));
+  }
+  return finish(std::nullopt);
+}
+
+}  // namespace rfem

@@ -1,0 +1,252 @@
+// A simulation a caller steps (studies/simulation.hpp): one advance to the end is `rfem run` bit for
+// bit; chunks agree with one run to the integrator's accuracy; a simulation started from a saved
+// state continues the original bit for bit; a held torque equal to the case's law changes nothing;
+// a digital PD controller converges to the continuous PD law at first order in its sample time;
+// the energy books balance with a controller in the loop; bad arguments are refused with one line.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "rfem/results/reader.hpp"
+#include "rfem/studies/simulation.hpp"
+#include "tests/test_models.hpp"
+
+using namespace rfem;
+
+namespace {
+
+// Kane's beam on a torque-driven hub (220 N m against drive damping and friction), 6 rfes.
+Case hub(double t_end) {
+  return read_case(test::source_path("cases/kane_hub_drive.toml"),
+                   {"simulation.t_end=" + std::to_string(t_end), "link.n=6", "simulation.output_dt=0.01"});
+}
+
+// The same beam on a PD-controlled hub following Kane's spin-up to 2 rad/s in 1 s (no feed-forward).
+Case pd_hub() {
+  return parse_case(R"(
+[materials.kane]
+E = 7.0e10
+G = 2.6923076923e10
+rho = 3000.0
+[sections.kane]
+A = 4.0e-4
+Iy = 2.0e-7
+Iz = 2.0e-7
+J = 4.0e-7
+[[joints]]
+name = "hub"
+drive = { inertia = 50.0 }
+input = { kind = "pd", reference = { kind = "spinup", Omega = 2.0, T = 1.0 }, kp = 4000.0, kd = 800.0 }
+[link]
+n = 4
+[[link.segments]]
+length = 10.0
+material = "kane"
+section = "kane"
+[simulation]
+t_end = 1.5
+output_dt = 0.01
+)",
+                    "pd_hub.toml");
+}
+
+SimulationOptions one_thread() {
+  SimulationOptions o;
+  o.threads = 1;
+  o.keep_series = true;
+  return o;
+}
+
+Table series(const RunResult& r, const std::string& name) { return r.series->table(name); }
+
+double max_abs(const Table& t) {
+  double m = 0.0;
+  for (double x : t.data) m = std::max(m, std::abs(x));
+  return m;
+}
+
+// max |a − b| over b's rows, each against a's row of the same time (b's rows at times a does not
+// have are skipped: a state's own row); at least `matched` rows must be compared.
+double max_difference(const Table& a, const Table& ta, const Table& b, const Table& tb, long matched = -1) {
+  double d = 0.0;
+  long i = 0, m = 0;
+  for (long j = 0; j < b.rows; ++j) {
+    while (i < a.rows && ta.at(i, 0) < tb.at(j, 0) - 1e-12) ++i;
+    if (i == a.rows || std::abs(ta.at(i, 0) - tb.at(j, 0)) > 1e-12) continue;
+    for (long c = 0; c < a.cols; ++c) d = std::max(d, std::abs(a.at(i, c) - b.at(j, c)));
+    ++m;
+  }
+  EXPECT_GE(m, matched < 0 ? b.rows : matched) << "rows compared";
+  return d;
+}
+
+}  // namespace
+
+TEST(Simulation, OneAdvanceToTheEndIsTheRunBitForBit) {
+  const Case cs = hub(0.5);
+  RunRequest rq;
+  rq.threads = 1;
+  const RunResult run = run_case(cs, rq).at(0);
+  Simulation sim(cs, one_thread());
+  EXPECT_EQ(sim.advance(sim.t_end()).kind, RunStatus::Kind::Completed);
+  const RunResult r = sim.finish();
+  ASSERT_TRUE(r.completed()) << r.status;
+  EXPECT_EQ(r.samples, run.samples);
+  EXPECT_EQ(r.stats.steps, run.stats.steps);
+  for (const char* name : {"tip_deflection", "joint_q", "joint_tau", "energy"})
+    EXPECT_EQ(series(r, name).data, series(run, name).data) << name;
+}
+
+TEST(Simulation, ChunksAgreeWithOneRunToTheIntegratorsAccuracy) {
+  // 1 ms chunks end a step at every millisecond: another step sequence, the same solution within
+  // the default tolerances' accuracy (README "Performance": integration error below 1e-4 of the
+  // peaks; two such solutions differ by at most twice that).
+  const Case cs = hub(0.5);
+  Simulation whole(cs, one_thread()), chunks(cs, one_thread());
+  whole.advance(0.5);
+  for (int k = 1; k <= 500; ++k) ASSERT_EQ(chunks.advance(std::min(0.5, k * 1e-3)).kind, k < 500 ? RunStatus::Kind::Running : RunStatus::Kind::Completed);
+  EXPECT_EQ(chunks.time(), 0.5);
+  const RunResult a = whole.finish(), b = chunks.finish();
+  const Table ua = series(a, "tip_deflection"), ub = series(b, "tip_deflection");
+  const double d = max_difference(ua, series(a, "time"), ub, series(b, "time"));
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3e", d / max_abs(ua));
+  RecordProperty("chunks_difference_relative", buf);
+  EXPECT_LT(d, 2e-4 * max_abs(ua));
+  EXPECT_GT(b.stats.steps, 500);  // a step ended at every chunk
+}
+
+TEST(Simulation, StartedFromAStateContinuesTheOriginalBitForBit) {
+  const Case cs = hub(0.4);
+  Simulation first(cs, one_thread());
+  first.advance(0.173);  // between outputs
+  const auto state = std::make_shared<const SimulationState>(first.state());
+  const std::string path = (std::filesystem::temp_directory_path() / "rfem_test_state.h5").string();
+  save_state(*state, path);
+  first.advance(0.4);
+  SimulationOptions o = one_thread();
+  o.state = std::make_shared<const SimulationState>(load_state(path));
+  std::filesystem::remove(path);
+  Simulation second(cs, o);
+  EXPECT_EQ(second.time(), 0.173);
+  EXPECT_EQ(second.q(), [&] {
+    Simulation again(cs, one_thread());
+    again.advance(0.173);
+    return again.q();
+  }());
+  second.advance(0.4);
+  EXPECT_EQ(first.q(), second.q());
+  EXPECT_EQ(first.v(), second.v());
+  const RunResult a = first.finish(), b = second.finish();
+  const Table tb = series(b, "time");
+  EXPECT_EQ(tb.at(0, 0), 0.173);  // the state's own row, then the grid
+  EXPECT_NEAR(tb.at(1, 0), 0.18, 1e-15);
+  EXPECT_EQ(max_difference(series(a, "tip_deflection"), series(a, "time"), series(b, "tip_deflection"), tb, tb.rows - 1), 0.0);
+}
+
+TEST(Simulation, AHeldTorqueEqualToTheCaseLawChangesNothing) {
+  const Case cs = hub(0.3);
+  Simulation a(cs, one_thread()), b(cs, one_thread()), c(cs, one_thread());
+  a.advance(0.1);
+  a.advance(0.3);
+  b.set_torque("hub", 220.0);  // the case's own value, held from t = 0: the same bits
+  b.advance(0.1);
+  b.advance(0.3);
+  EXPECT_EQ(a.q(), b.q());
+  // Held again at 0.1 s: the accelerations there are solved afresh instead of taken from the last
+  // stage (equal to the Newton tolerance), so equal to the integrator's accuracy (1e-4 of the peak).
+  c.advance(0.1);
+  c.set_torque("hub", 220.0);
+  c.advance(0.3);
+  const VecX qa = a.q();
+  EXPECT_LT((qa - c.q()).cwiseAbs().maxCoeff(), 1e-4 * qa.cwiseAbs().maxCoeff());
+  // A different torque does change the motion, and by the right sign.
+  Simulation d(cs, one_thread());
+  d.set_torque("hub", 440.0);
+  d.advance(0.3);
+  const int hub_q = d.model().joint_index(0);
+  EXPECT_GT(d.q()[hub_q], qa[hub_q]);
+}
+
+TEST(Simulation, DigitalPdConvergesToTheContinuousLawAtFirstOrder) {
+  // A controller computing the case's PD law from the sampled joint, held for a sample: the error
+  // against the continuous law is the zero-order hold's, O(Ts).
+  const Case cs = pd_hub();
+  RunRequest rq;
+  rq.threads = 1;
+  const RunResult continuous = run_case(cs, rq).at(0);
+  const auto reference = spinup_law(0.0, 2.0, 1.0);
+  const Controller pd = [&](double t, const Snapshot& y) {
+    const MotionSample r = reference->at(t);
+    ControlOutput u;
+    u.torques["hub"] = 4000.0 * (r.q - y.joint_q[0]) + 800.0 * (r.qd - y.joint_v[0]);
+    return u;
+  };
+  std::vector<double> errors;
+  for (double ts : {4e-3, 2e-3, 1e-3}) {
+    ControlOptions c;
+    c.sample_time = ts;
+    const RunResult r = run_controlled(cs, one_thread(), pd, c);
+    ASSERT_TRUE(r.completed()) << r.status;
+    const Table a = series(continuous, "joint_q"), b = series(r, "joint_q");
+    errors.push_back(max_difference(a, series(continuous, "time"), b, series(r, "time")));
+    // The books balance with the controller in the loop: the input work of the held torques is
+    // integrated exactly over steps that end at the samples.
+    EXPECT_LT(r.energy_drift, 1e-6 * r.energy_scale) << "Ts = " << ts;
+  }
+  for (size_t i = 1; i < errors.size(); ++i) {
+    const double order = std::log2(errors[i - 1] / errors[i]);
+    RecordProperty("order_" + std::to_string(i), std::to_string(order));
+    EXPECT_NEAR(order, 1.0, 0.15) << "errors " << errors[i - 1] << " -> " << errors[i];
+  }
+}
+
+TEST(Simulation, BadArgumentsAreRefusedWithOneLine) {
+  const Case cs = hub(0.2);
+  Simulation sim(cs, one_thread());
+  EXPECT_THROW(sim.set_torque("elbow", 1.0), std::invalid_argument);
+  EXPECT_THROW(sim.set_torque("hub", NAN), std::invalid_argument);
+  EXPECT_THROW(sim.set_reference("hub", 1.0), std::invalid_argument);  // a torque joint has no PD gains
+  EXPECT_THROW(sim.advance(0.3), std::invalid_argument);               // beyond t_end
+  sim.advance(0.1);
+  EXPECT_THROW(sim.advance(0.05), std::invalid_argument);  // backwards
+  EXPECT_THROW(sim.advance(NAN), std::invalid_argument);
+  // Another model's state (other n).
+  SimulationOptions o = one_thread();
+  o.state = std::make_shared<const SimulationState>(sim.state());
+  EXPECT_THROW(Simulation(read_case(test::source_path("cases/kane_hub_drive.toml"), {"link.n=7", "simulation.t_end=0.2"}), o),
+               std::invalid_argument);
+  // Controllers: bad sample times; one that throws or names an unknown joint fails the run with
+  // its message, the rows before kept in the file.
+  ControlOptions c;
+  const Controller zero = [](double, const Snapshot&) { return ControlOutput{}; };
+  c.sample_time = 0.0;
+  EXPECT_THROW(run_controlled(cs, one_thread(), zero, c), std::invalid_argument);
+  c.sample_time = 1.0;
+  EXPECT_THROW(run_controlled(cs, one_thread(), zero, c), std::invalid_argument);
+  c.sample_time = 0.01;
+  const std::string path = (std::filesystem::temp_directory_path() / "rfem_test_controller.h5").string();
+  SimulationOptions f = one_thread();
+  f.output = path;
+  const RunResult r = run_controlled(cs, f, [](double t, const Snapshot&) {
+    if (t > 0.1) throw std::runtime_error("sensor lost");
+    return ControlOutput{};
+  }, c);
+  EXPECT_EQ(r.status.kind, RunStatus::Kind::Failed);
+  EXPECT_NE(r.status.reason.find("controller: sensor lost"), std::string::npos) << r.status;
+  {
+    const ResultsReader in(path);
+    EXPECT_EQ(in.attribute("run", "status").rfind("failed: controller: sensor lost", 0), 0u);
+    EXPECT_GE(in.table("run/time").rows, 11);  // t = 0 … 0.1 s
+    EXPECT_GE(in.table("run/control").rows, 11);
+  }
+  const RunResult u = run_controlled(cs, f, [](double, const Snapshot&) {
+    ControlOutput out;
+    out.torques["elbow"] = 1.0;
+    return out;
+  }, c);
+  EXPECT_NE(u.status.reason.find("no joint named 'elbow'"), std::string::npos) << u.status;
+  std::filesystem::remove(path);
+}
