@@ -7,8 +7,11 @@
 // root link is the ground. Every URDF link's name is a frame a flexible link or a case joint may be
 // mounted on (`parent = "forearm"`).
 #include <console_bridge/console.h>
+#include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
 
+#include <cctype>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -50,6 +53,55 @@ urdf::ModelInterfaceSharedPtr parse(const std::string& text, std::string& error)
   return m;
 }
 
+// `count` finite numbers separated by white space, and nothing else.
+bool numbers(const char* text, int count) {
+  const char* p = text;
+  const char* end = text + std::char_traits<char>::length(text);
+  for (int i = 0; i < count; ++i) {
+    while (p < end && std::isspace(static_cast<unsigned char>(*p))) ++p;
+    if (p < end && *p == '+') ++p;  // (from_chars takes no '+')
+    double v = 0.0;
+    const auto [next, ec] = std::from_chars(p, end, v);
+    if (ec != std::errc() || next == p || !std::isfinite(v)) return false;
+    p = next;
+    if (p < end && !std::isspace(static_cast<unsigned char>(*p))) return false;  // "3.0x"
+  }
+  while (p < end && std::isspace(static_cast<unsigned char>(*p))) ++p;
+  return p == end;
+}
+
+// urdfdom reads numbers leniently ("three" as 0, "3.0 4.0" as 3.0, "nan" as NaN): every number rfem
+// takes from the file is read again here from the XML, strictly. `fail` gets "LINE: link 'x': …".
+void check_numbers(const std::string& text, const std::function<void(const std::string&)>& fail) {
+  TiXmlDocument doc;
+  doc.Parse(text.c_str());
+  const TiXmlElement* robot = doc.Error() ? nullptr : doc.FirstChildElement("robot");
+  if (!robot) return;  // urdfdom says what is wrong
+  auto check = [&](const TiXmlElement* parent, const char* tag, std::initializer_list<const char*> attrs, int count,
+                   const std::string& who) {
+    if (!parent) return;
+    for (const TiXmlElement* e = parent->FirstChildElement(tag); e; e = e->NextSiblingElement(tag))
+      for (const char* a : attrs)
+        if (const char* v = e->Attribute(a); v && !numbers(v, count))
+          fail(std::to_string(e->Row()) + ": " + who + ": <" + tag + " " + a + "=\"" + v + "\">: " +
+               (count == 1 ? "must be a finite number" : "must be " + std::to_string(count) + " finite numbers"));
+  };
+  for (const TiXmlElement* l = robot->FirstChildElement("link"); l; l = l->NextSiblingElement("link")) {
+    const std::string who = "link '" + std::string(l->Attribute("name") ? l->Attribute("name") : "") + "'";
+    const TiXmlElement* in = l->FirstChildElement("inertial");
+    check(in, "origin", {"xyz", "rpy"}, 3, who);
+    check(in, "mass", {"value"}, 1, who);
+    check(in, "inertia", {"ixx", "ixy", "ixz", "iyy", "iyz", "izz"}, 1, who);
+  }
+  for (const TiXmlElement* j = robot->FirstChildElement("joint"); j; j = j->NextSiblingElement("joint")) {
+    const std::string who = "joint '" + std::string(j->Attribute("name") ? j->Attribute("name") : "") + "'";
+    check(j, "origin", {"xyz", "rpy"}, 3, who);
+    check(j, "axis", {"xyz"}, 3, who);
+    check(j, "limit", {"lower", "upper", "effort", "velocity"}, 1, who);
+    check(j, "dynamics", {"damping", "friction"}, 1, who);
+  }
+}
+
 Mat4 pose(const urdf::Pose& p) {
   double x, y, z, w;
   p.rotation.getQuaternion(x, y, z, w);
@@ -69,10 +121,18 @@ void read_urdf_base(const Reader& r, const toml::table& bt, const std::string& c
   if (!in) r.fail(un, "base.urdf", "cannot open '" + file + "'");
   std::stringstream buf;
   buf << in.rdbuf();
+  check_numbers(buf.str(), [&](const std::string& what) { r.fail(un, "base.urdf", given + ":" + what); });
   std::string error;
   const urdf::ModelInterfaceSharedPtr model = parse(buf.str(), error);
   if (!model) fail(error);
   if (!model->getRoot()) fail("no root link");
+  {  // urdfdom keeps the last of a link's parent joints and drops the others without a word
+    std::map<std::string, std::string> parent_of;
+    for (const auto& [name, j] : model->joints_)
+      if (const auto [it, first] = parent_of.emplace(j->child_link_name, name); !first)
+        fail("link '" + j->child_link_name + "' has two parent joints, '" + it->second + "' and '" + name +
+             "' (a URDF is a tree: each link hangs on one joint)");
+  }
   c.urdf = file;
 
   // Per joint of the URDF: value, rate, input, drive ([base.joints.NAME]).
