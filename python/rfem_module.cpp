@@ -145,6 +145,7 @@ RunRequest python_request(const std::shared_ptr<Pending>& pending, py::object pr
 }  // namespace
 
 void bind_sweep(py::module_& m);  // (sweep_bindings.cpp)
+void bind_simulation(py::module_& m);  // (simulation_bindings.cpp)
 
 PYBIND11_MODULE(_rfem, m) {
   m.doc() = "rfem's compiled core; use the package `rfem` (help(rfem)).";
@@ -465,4 +466,5 @@ PYBIND11_MODULE(_rfem, m) {
   }, py::arg("case"), py::arg("ns"), py::arg("quantities"), py::arg("output"), py::arg("integration_check"),
      py::arg("rate"), py::arg("joint"), py::arg("threads"), py::arg("progress"));
   bind_sweep(m);
+  bind_simulation(m);
 }

@@ -234,6 +234,8 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
   m.stepper = std::make_unique<EsdirkStepper>(*m.eq, m.o);
   m.sink = [&m](const OutputSample& x) { m.book->sample(x); };
   m.control.stop = m.rq.stop;
+  m.control.heartbeat = m.opts.heartbeat;
+  m.control.heartbeat_interval = m.opts.heartbeat_interval;
   m.emit = std::make_unique<SampleEmitter>(m.sink, m.control);
   try {
     m.status = m.stepper->start(*m.emit);

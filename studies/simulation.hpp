@@ -50,6 +50,10 @@ struct SimulationOptions {
   std::vector<RunObserver*> observers;  ///< the caller keeps them alive while the simulation lives
   Warnings warn;
   StopToken stop;            ///< request() ends the current advance() within a step (Interrupted)
+  /// Called from advance()'s step loop at most every heartbeat_interval seconds of wall time (to
+  /// poll something of the caller's: Python's Ctrl-C); if it throws, the run fails with its message.
+  std::function<void(double t, long steps)> heartbeat;
+  double heartbeat_interval = 0.1;  ///< [s]
 };
 
 /// What a lab measures at the simulation's time: joint encoders and torques (applied, or required

@@ -313,3 +313,9 @@ def plot(results, outdir=None, format="png", paper_signs=False):
         lines = [l for l in p.stderr.strip().splitlines() if l.startswith("rfem plot: error: ")] or p.stderr.strip().splitlines()
         raise RuntimeError(lines[-1].replace("rfem plot: error: ", "") if lines else "rfem plot failed")
     return [l[len("wrote "):] for l in p.stdout.splitlines() if l.startswith("wrote ")]
+
+
+# A simulation a script steps and controllers in the loop (python/rfem/simulation.py).
+from .simulation import Simulation, SimulationState, load_state, run_controlled  # noqa: E402
+
+__all__ += ["Simulation", "SimulationState", "load_state", "run_controlled"]

@@ -1,0 +1,172 @@
+"""A simulation a script steps, and controllers in the loop (rfem.Simulation, rfem.run_controlled).
+
+    sim = rfem.Simulation(case, n=10)          # the case's initial state (or state=...)
+    while sim.time < 1.0:
+        y = sim.snapshot()                      # joint q, qd, tau, tips: dicts by name
+        sim.set_torque("hub", -50.0 * y["qd"]["hub"])
+        sim.advance(sim.time + 1e-3)            # the last step ends exactly there
+    state = sim.state()                         # start other simulations from it, save, pickle
+    run = sim.finish()                          # the Run (status, peaks, series)
+
+The library's studies/simulation.hpp does the work; see README.md, "Control in the loop".
+"""
+
+import math as _math
+import os as _os
+
+from . import _rfem
+from ._rfem import SimulationState
+
+__all__ = ["Simulation", "SimulationState", "run_controlled", "load_state"]
+
+
+def _case(case):
+    if isinstance(case, _rfem.Case):
+        return case
+    if isinstance(case, (str, bytes, _os.PathLike)):
+        return _rfem.Case.load(_os.fsdecode(case))
+    raise TypeError(f"case must be an rfem.Case or a path, not {type(case).__name__}")
+
+
+def _n(n):
+    if n is None:
+        return 0
+    if isinstance(n, bool) or not isinstance(n, int):
+        raise TypeError(f"n must be a whole number of rfes, not {type(n).__name__}")
+    if n < 1:
+        raise ValueError(f"n = {n}: must be at least 1 rfe (None: the case's own)")
+    return n
+
+
+def _threads(threads):
+    if isinstance(threads, bool) or not isinstance(threads, int):
+        raise TypeError(f"threads must be a whole number, not {type(threads).__name__}")
+    if threads < 0:
+        raise ValueError(f"threads = {threads}: must be 0 (all cores) or more")
+    return threads
+
+
+def _state(state):
+    if state is None or isinstance(state, SimulationState):
+        return state
+    if isinstance(state, (str, _os.PathLike)):
+        return load_state(state)
+    raise TypeError(f"state must be an rfem.SimulationState or a file, not {type(state).__name__}")
+
+
+def _raise_interrupt(error, result):
+    from . import RunInterrupted  # (the package's; imported late: this module is part of it)
+    if isinstance(error, KeyboardInterrupt):
+        raise RunInterrupted(result, "interrupted by Ctrl-C; the results so far are in .result") from error
+    raise error
+
+
+def load_state(path):
+    """A state saved with SimulationState.save (HDF5) or numpy.savez (.npz with `model`, `packed`)."""
+    path = _os.fspath(path)
+    if path.endswith(".npz"):
+        import numpy as np
+        with np.load(path) as z:
+            return SimulationState.unpack(str(z["model"]), z["packed"])
+    return SimulationState.load(path)
+
+
+class Simulation:
+    """A run of the case that a script steps, its integrator's state kept between calls.
+
+    case:        an rfem.Case or a case file
+    n:           rfes in all links (None: the case's own)
+    output:      an HDF5 results file written as it goes (the layout of `rfem run`, group "run")
+    state:       start from an rfem.SimulationState (or a file saved from one) of the same model
+    threads:     kernel threads (0: all cores)
+    keep_series: keep every series in memory for finish()'s Run
+
+    time, t_end [s]; q, v: every coordinate and rate in the model's order (numpy), named by
+    coordinate_names (LINK/rfeK/x1 … phi3, then the joints); joint_names, joint_inputs ("motion",
+    "torque" or "feedback"). The integrator is ESDIRK (simulation.integrator = "bdf" is refused).
+    Not thread-safe: one thread steps a simulation."""
+
+    def __init__(self, case, n=None, output=None, state=None, threads=0, keep_series=True):
+        self._sim = _rfem._Simulation(_case(case), _n(n), _threads(threads), _os.fspath(output) if output else "",
+                                      bool(keep_series), _state(state), "rfem.Simulation (Python)")
+
+    time = property(lambda self: self._sim.time, doc="where the simulation is [s]")
+    t_end = property(lambda self: self._sim.t_end, doc="the case's simulation.t_end [s]: advance() goes no further")
+    q = property(lambda self: self._sim.q, doc="every coordinate (numpy, the model's order)")
+    v = property(lambda self: self._sim.v, doc="every rate (numpy, the model's order)")
+    coordinate_names = property(lambda self: self._sim.coordinate_names)
+    joint_names = property(lambda self: self._sim.joint_names)
+    joint_inputs = property(lambda self: self._sim.joint_inputs)
+    status = property(lambda self: self._sim.status, doc='"running", "completed", "failed: …", …')
+    finished = property(lambda self: self._sim.finished)
+
+    def advance(self, t):
+        """Integrates to t [s] (time ≤ t ≤ t_end), the last step ending exactly at t; returns the
+        status. Ctrl-C raises RunInterrupted (the rows so far are kept)."""
+        if isinstance(t, bool) or not isinstance(t, (int, float)) or not _math.isfinite(t):
+            raise TypeError(f"advance: t must be a finite number of seconds, got {t!r}")
+        status, error = self._sim.advance(float(t))
+        if error is not None:
+            _raise_interrupt(error, self._sim.finish())
+        return status
+
+    def set_torque(self, joint, tau):
+        """Holds torque (force) tau [N m or N] on a force-input joint from now on (zero-order hold)."""
+        self._sim.set_torque(joint, float(tau))
+
+    def set_reference(self, joint, q, qd=0.0, tau_ff=0.0):
+        """Holds the reference of a PD joint: tau = tau_ff + kp (q - joint q) + kd (qd - joint qd)."""
+        self._sim.set_reference(joint, float(q), float(qd), float(tau_ff))
+
+    def release(self, joint):
+        """The joint follows the case's own law again."""
+        self._sim.release(joint)
+
+    def snapshot(self):
+        """What a lab measures now: {"t", "q", "qd", "tau": {joint: value}, "tip_position",
+        "tip_deflection": {link: array of 3}} (u1, u2 [m], theta [rad] in the link's frame)."""
+        return self._sim.snapshot()
+
+    def state(self):
+        """The state now (rfem.SimulationState): rfem.Simulation(case, state=...) goes on from it."""
+        return self._sim.state()
+
+    def finish(self):
+        """Ends the run (completed at t_end, else "interrupted (stopped)"), closes the file, returns the Run."""
+        return self._sim.finish()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.finish()
+        return False
+
+    def __repr__(self):
+        return f"<rfem.Simulation t = {self.time:g} s of {self.t_end:g} s, {self.status}>"
+
+
+def run_controlled(case, controller, sample_time, n=None, delay=0, output=None, state=None, threads=0,
+                   keep_series=True):
+    """Runs the case with controller(t, y) in the loop at t = k * sample_time: y is the snapshot
+    there (Simulation.snapshot) and it returns a dict by joint name — a torque [N m or N] for a
+    force-input joint, a reference q_ref or (q_ref, qd_ref[, tau_ff]) for a PD joint — held from
+    t_{k+delay} until the next output takes effect (zero-order hold). Returns the Run; the
+    controller's outputs are in the results file's run/control. An exception in the controller ends
+    the run "failed: controller: …" (rows kept); a return that is not a dict of finite numbers by
+    known joints raises TypeError or ValueError (the run in .run); Ctrl-C raises RunInterrupted."""
+    if not callable(controller):
+        raise TypeError(f"controller must be callable f(t, y), not {type(controller).__name__}")
+    if isinstance(sample_time, bool) or not isinstance(sample_time, (int, float)):
+        raise TypeError(f"sample_time must be a number of seconds, not {type(sample_time).__name__}")
+    if isinstance(delay, bool) or not isinstance(delay, int):
+        raise TypeError(f"delay must be a whole number of samples, not {type(delay).__name__}")
+    run, error, bad = _rfem._run_controlled(_case(case), _n(n), _threads(threads), _os.fspath(output) if output else "",
+                                            bool(keep_series), _state(state), "rfem.run_controlled (Python)", controller,
+                                            float(sample_time), delay)
+    if error is not None:
+        _raise_interrupt(error, run)
+    if bad is not None:
+        bad.run = run
+        raise bad
+    return run

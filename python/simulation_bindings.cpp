@@ -1,0 +1,250 @@
+// rfem.Simulation (a run a script steps) and rfem.run(controller=…) for Python. The integration
+// runs with the GIL released; a heartbeat takes it back to poll Ctrl-C, and a Python controller
+// takes it for its call only. Python's package (python/rfem/simulation.py) wraps these.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <csignal>
+#include <memory>
+
+#include "rfem/studies/inputs.hpp"
+#include "rfem/studies/simulation.hpp"
+
+namespace py = pybind11;
+using namespace rfem;
+
+namespace {
+
+// Ctrl-C while C++ integrates: the heartbeat and the controller poll Python's signals; the first
+// exception is kept (raised when the call returns) and stops the run within a step.
+struct Poll {
+  StopToken stop;
+  py::object error = py::none();  // a KeyboardInterrupt (or the exception a heartbeat raised)
+  py::object bad = py::none();    // what a controller returned that it should not have: TypeError, ValueError
+  void check() {
+    py::gil_scoped_acquire gil;
+    if (!error.is_none()) return;
+    if (PyErr_CheckSignals() != 0) {
+      py::error_already_set e;
+      error = e.value();
+      stop.request(SIGINT);
+    }
+  }
+};
+
+py::array_t<double> array(const VecX& v) { return py::array_t<double>(v.size(), v.data()); }
+
+py::dict snapshot_dict(const Snapshot& y, const Model& model) {
+  py::dict q, qd, tau, tip, defl;
+  for (int j = 0; j < model.m(); ++j) {
+    const py::str name(model.joints[j].name);
+    q[name] = y.joint_q[j];
+    qd[name] = y.joint_v[j];
+    tau[name] = y.joint_tau[j];
+  }
+  for (size_t l = 0; l < model.links.size(); ++l) {
+    const py::str name(model.links[l].name);
+    tip[name] = py::array_t<double>(3, y.tip_position[l].data());
+    defl[name] = py::array_t<double>(3, y.tip_deflection[l].data());
+  }
+  py::dict d;
+  d["t"] = y.t;
+  d["q"] = q;
+  d["qd"] = qd;
+  d["tau"] = tau;
+  d["tip_position"] = tip;
+  d["tip_deflection"] = defl;
+  return d;
+}
+
+SimulationOptions options(int n, int threads, const std::string& output, bool keep_series,
+                          std::optional<SimulationState> state, const std::string& made_by, const std::shared_ptr<Poll>& poll) {
+  SimulationOptions o;
+  o.n = n;
+  o.threads = threads;
+  o.output = output;
+  o.keep_series = keep_series;
+  o.made_by = made_by;
+  if (state) o.state = std::make_shared<const SimulationState>(std::move(*state));
+  o.stop = poll->stop;
+  o.heartbeat = [poll](double, long) { poll->check(); };
+  return o;
+}
+
+// One Python value of a controller's dict for joint `name` of input kind `kind`.
+void control_value(ControlOutput& u, const std::string& name, const std::string& kind, const py::handle& v, Poll& poll) {
+  auto bad = [&](PyObject* type, const std::string& msg) {
+    poll.bad = py::reinterpret_borrow<py::object>(type)(msg);
+    throw std::invalid_argument(msg);
+  };
+  auto number = [&](const py::handle& x) {
+    if (!py::isinstance<py::float_>(x) && !py::isinstance<py::int_>(x) && !py::hasattr(x, "__float__"))
+      bad(PyExc_TypeError, "joint '" + name + "': expected a number, got " + std::string(py::str(py::type::of(x).attr("__name__"))));
+    return x.cast<double>();
+  };
+  if (kind == "motion") bad(PyExc_ValueError, "joint '" + name + "' follows a prescribed motion: it takes no torque or reference");
+  if (kind == "torque") {
+    u.torques[name] = number(v);
+    return;
+  }
+  ControlOutput::Reference r;  // feedback: q_ref, or (q_ref, q̇_ref[, τ_ff])
+  if (py::isinstance<py::tuple>(v) || py::isinstance<py::list>(v)) {
+    const py::sequence s = py::reinterpret_borrow<py::sequence>(v);
+    if (s.size() < 1 || s.size() > 3) bad(PyExc_ValueError, "joint '" + name + "': a reference is q_ref or (q_ref, qd_ref[, tau_ff])");
+    r.q = number(s[0]);
+    if (s.size() > 1) r.v = number(s[1]);
+    if (s.size() > 2) r.tau_ff = number(s[2]);
+  } else {
+    r.q = number(v);
+  }
+  u.references[name] = r;
+}
+
+}  // namespace
+
+void bind_simulation(py::module_& m) {
+  py::class_<SimulationState>(m, "SimulationState",
+                              "A simulation's state (rfem.Simulation.state()): start other simulations from it, save it, pickle it.")
+      .def_property_readonly("time", &SimulationState::time, "[s]")
+      .def_readonly("model", &SimulationState::model, "the signature of the model it belongs to")
+      .def_property_readonly("unknowns_q", [](const SimulationState& s) { return array(s.integrator.q); },
+                             "the integrated coordinates (rfes, then the force-input joints)")
+      .def_property_readonly("unknowns_v", [](const SimulationState& s) { return array(s.integrator.v); })
+      .def("pack", [](const SimulationState& s) { const auto x = s.pack(); return py::array_t<double>(x.size(), x.data()); },
+           "the state as one float64 array (with .model, what unpack takes)")
+      .def_static("unpack", &SimulationState::unpack, py::arg("model"), py::arg("packed"))
+      .def("save", [](const SimulationState& s, const std::string& path) { save_state(s, path); }, py::arg("path"),
+           "into an HDF5 file of its own (state/packed, state/model)")
+      .def_static("load", &load_state, py::arg("path"))
+      .def(py::pickle([](const SimulationState& s) { return py::make_tuple(s.model, s.pack()); },
+                      [](const py::tuple& t) {
+                        if (t.size() != 2) throw std::invalid_argument("not a pickled SimulationState");
+                        return SimulationState::unpack(t[0].cast<std::string>(), t[1].cast<std::vector<double>>());
+                      }))
+      .def("__repr__", [](const SimulationState& s) {
+        return "<rfem.SimulationState t = " + std::to_string(s.time()) + " s, " + std::to_string(s.integrator.q.size()) + " unknowns>";
+      });
+
+  struct PySimulation {
+    std::shared_ptr<Poll> poll = std::make_shared<Poll>();
+    std::unique_ptr<Simulation> sim;
+  };
+  py::class_<PySimulation>(m, "_Simulation")
+      .def(py::init([](const Case& cs, int n, int threads, const std::string& output, bool keep_series,
+                       std::optional<SimulationState> state, const std::string& made_by) {
+             auto p = std::make_unique<PySimulation>();
+             SimulationOptions o = options(n, threads, output, keep_series, std::move(state), made_by, p->poll);
+             py::gil_scoped_release release;
+             p->sim = std::make_unique<Simulation>(cs, std::move(o));
+             return p;
+           }),
+           py::arg("case"), py::arg("n"), py::arg("threads"), py::arg("output"), py::arg("keep_series"), py::arg("state"),
+           py::arg("made_by"))
+      .def_property_readonly("time", [](const PySimulation& p) { return p.sim->time(); })
+      .def_property_readonly("t_end", [](const PySimulation& p) { return p.sim->t_end(); })
+      .def_property_readonly("q", [](const PySimulation& p) { return array(p.sim->q()); })
+      .def_property_readonly("v", [](const PySimulation& p) { return array(p.sim->v()); })
+      .def_property_readonly("coordinate_names", [](const PySimulation& p) { return p.sim->coordinate_names(); })
+      .def_property_readonly("joint_names", [](const PySimulation& p) { return p.sim->joint_names(); })
+      .def_property_readonly("joint_inputs", [](const PySimulation& p) { return p.sim->joint_inputs(); })
+      .def_property_readonly("status", [](const PySimulation& p) { return p.sim->status().to_string(); })
+      .def_property_readonly("finished", [](const PySimulation& p) { return p.sim->finished(); })
+      .def_property_readonly("output", [](const PySimulation& p) { return p.sim->output(); })
+      .def("set_torque", [](PySimulation& p, const std::string& j, double tau) { p.sim->set_torque(j, tau); })
+      .def("set_reference", [](PySimulation& p, const std::string& j, double q, double v, double ff) { p.sim->set_reference(j, q, v, ff); })
+      .def("release", [](PySimulation& p, const std::string& j) { p.sim->release(j); })
+      .def("advance", [](PySimulation& p, double t) {
+        RunStatus s;
+        {
+          py::gil_scoped_release release;
+          s = p.sim->advance(t);
+        }
+        py::object error = p.poll->error;
+        p.poll->error = py::none();
+        return py::make_tuple(s.to_string(), error);
+      })
+      .def("snapshot", [](PySimulation& p) { return snapshot_dict(p.sim->snapshot(), p.sim->model()); })
+      .def("state", [](const PySimulation& p) { return p.sim->state(); })
+      .def("finish", [](PySimulation& p) {
+        std::shared_ptr<RunResult> r;
+        {
+          py::gil_scoped_release release;
+          r = std::make_shared<RunResult>(p.sim->finish());
+        }
+        return r;
+      });
+
+  m.def("_run_controlled", [](const Case& cs, int n, int threads, const std::string& output, bool keep_series,
+                              std::optional<SimulationState> state, const std::string& made_by, py::object controller,
+                              double sample_time, int delay) {
+    auto poll = std::make_shared<Poll>();
+    SimulationOptions o = options(n, threads, output, keep_series, std::move(state), made_by, poll);
+    const std::vector<std::string> kinds = input_kinds(joint_inputs(cs));
+    std::vector<std::string> names;
+    for (const auto& j : cs.joints) names.push_back(j.name);
+    std::shared_ptr<const Model> model;
+    const Controller f = [&](double t, const Snapshot& y) {
+      py::gil_scoped_acquire gil;
+      ControlOutput u;
+      if (PyErr_CheckSignals() != 0) {
+        py::error_already_set e;
+        poll->error = e.value();
+        poll->stop.request(SIGINT);
+        return u;
+      }
+      py::object r;
+      try {
+        r = controller(t, snapshot_dict(y, *model));
+      } catch (py::error_already_set& e) {
+        if (e.matches(PyExc_KeyboardInterrupt)) {
+          poll->error = e.value();
+          poll->stop.request(SIGINT);
+          return u;
+        }
+        // The run ends `failed: controller: TYPE: message`, the Python exception not raised again.
+        throw std::runtime_error(py::str(e.type().attr("__name__")).cast<std::string>() + ": " + py::str(e.value()).cast<std::string>());
+      }
+      if (!py::isinstance<py::dict>(r)) {
+        const std::string msg = "the controller must return a dict by joint name ({\"hub\": 1.5}), not " +
+                                py::str(py::type::of(r).attr("__name__")).cast<std::string>();
+        poll->bad = py::reinterpret_borrow<py::object>(PyExc_TypeError)(msg);
+        throw std::invalid_argument(msg);
+      }
+      for (const auto& [k, v] : py::reinterpret_borrow<py::dict>(r)) {
+        if (!py::isinstance<py::str>(k)) {
+          const std::string msg = "the controller's dict must have joint names as keys";
+          poll->bad = py::reinterpret_borrow<py::object>(PyExc_TypeError)(msg);
+          throw std::invalid_argument(msg);
+        }
+        const std::string name = k.cast<std::string>();
+        const auto it = std::find(names.begin(), names.end(), name);
+        if (it == names.end()) {
+          std::string known;
+          for (const auto& x : names) known += (known.empty() ? "" : ", ") + x;
+          const std::string msg = "no joint named '" + name + "' (joints: " + known + ")";
+          poll->bad = py::reinterpret_borrow<py::object>(PyExc_ValueError)(msg);
+          throw std::invalid_argument(msg);
+        }
+        control_value(u, name, kinds[static_cast<size_t>(it - names.begin())], v, *poll);
+      }
+      return u;
+    };
+    ControlOptions c;
+    c.sample_time = sample_time;
+    c.delay = delay;
+    std::shared_ptr<RunResult> result;
+    {
+      py::gil_scoped_release release;
+      model = model_of(cs, n);  // (the snapshot's names; the same as the run's model)
+      result = std::make_shared<RunResult>(run_controlled(cs, std::move(o), f, c));
+    }
+    // A non-finite value the C++ loop refused is a ValueError too.
+    if (poll->bad.is_none() && result->status.kind == RunStatus::Kind::Failed &&
+        result->status.reason.find("is not finite") != std::string::npos && result->status.reason.rfind("controller: ", 0) == 0)
+      poll->bad = py::reinterpret_borrow<py::object>(PyExc_ValueError)(result->status.reason);
+    return py::make_tuple(result, poll->error, poll->bad);
+  }, py::arg("case"), py::arg("n"), py::arg("threads"), py::arg("output"), py::arg("keep_series"), py::arg("state"),
+     py::arg("made_by"), py::arg("controller"), py::arg("sample_time"), py::arg("delay"));
+}

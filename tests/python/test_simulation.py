@@ -1,0 +1,132 @@
+"""rfem.Simulation and controllers in the loop from Python: one advance to the end is rfem.run bit
+for bit; a saved state (HDF5, numpy, pickle) continues the original bit for bit; a controller
+holding the case's own torque gives the plain run within the integrator's accuracy and keeps the
+energy books; bad controllers, states and arguments give TypeError/ValueError with one line; Ctrl-C
+in a controller is RunInterrupted with the rows kept."""
+import os
+import pickle
+
+import h5py
+import numpy as np
+import pytest
+
+import rfem
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def hub(t_end=0.4, n=6):
+    """Kane's beam on a hub driven by 220 N m (drive damping and friction), 6 rfes."""
+    return rfem.load(os.path.join(ROOT, "cases", "kane_hub_drive.toml"),
+                     overrides=[f"simulation.t_end={t_end}", f"link.n={n}", "simulation.output_dt=0.01"])
+
+
+def test_one_advance_is_the_run_bit_for_bit():
+    case = hub()
+    run = rfem.run(case, threads=1)["run"]
+    sim = rfem.Simulation(case, threads=1)
+    assert sim.advance(sim.t_end) == "completed"
+    r = sim.finish()
+    assert r.status == "completed"
+    for name in ("tip_deflection", "joint_q", "energy"):
+        assert np.array_equal(r.table(name), run.table(name)), name
+    assert len(sim.q) == len(sim.coordinate_names) == 6 * 6 + 1
+    assert sim.coordinate_names[0] == "link/rfe1/x1" and sim.coordinate_names[-1] == "hub"
+
+
+@pytest.mark.parametrize("how", ["pickle", "h5", "npz"])
+def test_a_saved_state_continues_bit_for_bit(tmp_path, how):
+    case = hub()
+    first = rfem.Simulation(case, threads=1)
+    first.advance(0.15)
+    state = first.state()
+    if how == "pickle":
+        state = pickle.loads(pickle.dumps(state))
+    elif how == "h5":
+        state.save(str(tmp_path / "s.h5"))
+        state = rfem.load_state(tmp_path / "s.h5")
+    else:
+        np.savez(tmp_path / "s.npz", model=state.model, packed=state.pack())
+        state = rfem.load_state(tmp_path / "s.npz")
+    second = rfem.Simulation(case, state=state, threads=1)
+    assert second.time == 0.15
+    first.advance(0.4)
+    second.advance(0.4)
+    assert np.array_equal(first.q, second.q) and np.array_equal(first.v, second.v)
+    # Another model's state: one line.
+    with pytest.raises(ValueError, match="another model"):
+        rfem.Simulation(hub(n=7), state=state)
+
+
+def test_a_controller_holding_the_case_torque_is_the_plain_run(tmp_path):
+    # Steps end at every sample (another step sequence): equal within the default tolerances'
+    # accuracy (README, "Performance": 1e-4 of the peaks).
+    case = hub()
+    plain = rfem.run(case, threads=1)["run"]
+    calls = []
+
+    def f(t, y):
+        calls.append(t)
+        assert set(y) == {"t", "q", "qd", "tau", "tip_position", "tip_deflection"}
+        return {"hub": 220.0}
+
+    r = rfem.run_controlled(case, f, sample_time=2e-3, output=tmp_path / "c.h5", threads=1)
+    assert r.completed
+    assert len(calls) == 200 and calls[1] == 2e-3
+    a, b = plain.table("tip_deflection"), r.table("tip_deflection")
+    assert np.abs(a - b).max() < 1e-4 * np.abs(a).max()
+    assert r.energy_drift < 1e-6 * r.energy_scale
+    with h5py.File(tmp_path / "c.h5") as h:
+        control = h["run/control"][()]
+        assert control.shape == (200, 2) and np.all(control[:, 1] == 220.0)
+        assert h["run"].attrs["status"] == "completed"
+
+
+def test_bad_controllers_and_arguments(tmp_path):
+    case = hub(t_end=0.1)
+    for f, err, text in [(lambda t, y: 3.0, TypeError, "must return a dict"),
+                         (lambda t, y: {"elbow": 1.0}, ValueError, "no joint named 'elbow'"),
+                         (lambda t, y: {"hub": float("nan")}, ValueError, "not finite"),
+                         (lambda t, y: {"hub": "x"}, TypeError, "expected a number")]:
+        with pytest.raises(err, match=text) as e:
+            rfem.run_controlled(case, f, sample_time=1e-2, output=tmp_path / "bad.h5")
+        assert e.value.run.status.startswith("failed: controller: ")
+        with h5py.File(tmp_path / "bad.h5") as h:  # the file says so too
+            assert h["run"].attrs["status"].startswith("failed: controller: ")
+    for ts, err in [(0.0, ValueError), (-1.0, ValueError), (1.0, ValueError), ("1", TypeError)]:
+        with pytest.raises(err):
+            rfem.run_controlled(case, lambda t, y: {}, sample_time=ts)
+
+    def boom(t, y):
+        if t > 0.05:
+            raise RuntimeError("sensor lost")
+        return {}
+
+    r = rfem.run_controlled(case, boom, sample_time=1e-2, output=tmp_path / "boom.h5")
+    assert r.status.startswith("failed: controller: RuntimeError: sensor lost")
+    with h5py.File(tmp_path / "boom.h5") as h:
+        assert h["run/time"].shape[0] >= 6  # t = 0 … 0.05 s kept
+    sim = rfem.Simulation(case)
+    with pytest.raises(ValueError, match="no joint named"):
+        sim.set_torque("elbow", 1.0)
+    with pytest.raises(ValueError, match="finite"):
+        sim.set_torque("hub", float("inf"))
+    with pytest.raises(ValueError, match="t_end"):
+        sim.advance(1.0)
+    with pytest.raises(TypeError):
+        rfem.Simulation(case, n=4.5)
+
+
+def test_ctrl_c_in_a_controller_is_an_interruption(tmp_path):
+    case = hub(t_end=0.2)
+
+    def f(t, y):
+        if t >= 0.1:
+            raise KeyboardInterrupt
+        return {"hub": 200.0}
+
+    with pytest.raises(rfem.RunInterrupted) as e:
+        rfem.run_controlled(case, f, sample_time=1e-2, output=tmp_path / "i.h5")
+    assert e.value.result.status.startswith("interrupted")
+    with h5py.File(tmp_path / "i.h5") as h:
+        assert h["run/time"].shape[0] >= 11
