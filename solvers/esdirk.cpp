@@ -296,9 +296,16 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
       // Land exactly on the next breakpoint of the inputs, on the caller's `until` and on t_end;
       // stretch a step that would leave a sliver.
       while (next_break < breaks.size() && breaks[next_break] <= t * (1 + 1e-14)) ++next_break;
-      const double t_stop = std::min(next_break < breaks.size() ? breaks[next_break] : o.t_end, until);
+      const double t_law = next_break < breaks.size() ? breaks[next_break] : o.t_end;
+      const double t_stop = std::min(t_law, until);
+      // The caller's stops (a controller's samples) come often: two equal steps instead of a step
+      // and a sliver, and the step after a stop sized from what the controller proposed before it
+      // (a run without such stops takes the same steps as always).
+      const bool callers = until < t_law;
+      const double h_proposed = h;
       const bool lands = t + 1.05 * h >= t_stop;
       if (lands) h = t_stop - t;
+      else if (callers && o.fixed_step <= 0 && t + 2 * h > t_stop) h = 0.5 * (t_stop - t);
       const double hg = h * T.gamma;
       weights(q, v, nullptr, nullptr);
 
@@ -446,7 +453,7 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
       fac = std::clamp(fac, kMinFactor, last_rejected ? 1.0 : kMaxFactor);
       err_prev = err;
       last_rejected = nonfinite = false;
-      h = o.fixed_step > 0 ? o.fixed_step : h * fac;
+      h = o.fixed_step > 0 ? o.fixed_step : (callers ? std::max(h, h_proposed) : h) * fac;
       if (o.max_step > 0) h = std::min(h, o.max_step);
       if (!emit.checkpoint([&] { return state(); })) return emit.failure();
     }
