@@ -3,7 +3,8 @@
 // and refinement are library calls, with the library's checks and messages. Long calls release
 // the GIL; a heartbeat from the integration loop takes it back to poll Python's signals (Ctrl-C
 // stops the run within a step, its partial results kept) and to call the user's progress callback.
-// Series come back as read-only numpy views of the library's own buffers (no copy).
+// Series come back as read-only numpy views of the library's own buffers (no copy). Arguments are
+// checked in arguments.hpp (TypeError, ValueError naming the argument).
 #include <pybind11/eigen.h>
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
@@ -13,6 +14,7 @@
 #include <csignal>
 #include <memory>
 
+#include "arguments.hpp"
 #include "rfem/cases/case_file.hpp"
 #include "rfem/results/xdmf.hpp"
 #include "rfem/results/errors.hpp"
@@ -28,6 +30,7 @@
 
 namespace py = pybind11;
 using namespace rfem;
+namespace args = rfem::pyargs;
 
 namespace {
 
@@ -119,22 +122,45 @@ std::vector<RunName> run_names(const std::vector<std::string>& names) {
   return out;
 }
 
-JointRate joint_rate(std::optional<double> rate, int joint) {
+JointRate joint_rate(py::handle rate, py::handle joint) {
+  const std::optional<double> x = args::optional_real(rate, "rate", "a finite rate [rad/s or m/s] or None");
   JointRate r;
-  r.given = rate.has_value();
-  r.rate = rate.value_or(0.0);
-  r.joint = joint;
+  r.given = x.has_value();
+  r.rate = x.value_or(0.0);
+  r.joint = args::positive(joint, "joint");
   return r;
 }
 
+// `free` of rfem.modes: joint names or numbers from 1 (as --free), one or a list.
+std::vector<std::string> free_joints(py::handle v) {
+  std::vector<std::string> out;
+  auto one = [&](py::handle x) {
+    const std::string name = "free[" + std::to_string(out.size()) + "]";
+    if (PyUnicode_Check(x.ptr()) || PyBool_Check(x.ptr()) || !PyIndex_Check(x.ptr())) {
+      if (!PyUnicode_Check(x.ptr())) args::type_error(name, "a joint's name or number from 1", x);
+      out.push_back(args::text(x, name));
+    } else {
+      out.push_back(std::to_string(args::positive(x, name)));
+    }
+  };
+  if (v.is_none()) return out;
+  if (PyUnicode_Check(v.ptr()) || PyIndex_Check(v.ptr())) {
+    one(v);
+    return out;
+  }
+  if (!py::isinstance<py::iterable>(v)) args::type_error("free", "a list of joint names or numbers from 1", v);
+  for (py::handle x : py::reinterpret_borrow<py::iterable>(v)) one(x);
+  return out;
+}
+
 // A run request from Python: progress and Ctrl-C through `pending`, warnings collected.
-RunRequest python_request(const std::shared_ptr<Pending>& pending, py::object progress, int threads, bool keep_series,
-                          double checkpoint, std::vector<std::string>& warnings) {
-  pending->progress = std::move(progress);
+RunRequest python_request(const std::shared_ptr<Pending>& pending, py::handle progress, py::handle threads, py::handle keep_series,
+                          py::handle checkpoint, std::vector<std::string>& warnings) {
+  pending->progress = args::callback(progress, "progress");
   RunRequest rq;
-  rq.threads = threads;
-  rq.keep_series = keep_series;
-  rq.checkpoint_interval = checkpoint;
+  rq.threads = args::threads(threads);
+  rq.keep_series = args::flag(keep_series, "keep_series");
+  rq.checkpoint_interval = args::non_negative(checkpoint, "checkpoint", "a finite number of seconds, 0 (none) or more");
   rq.stop = pending->stop;
   rq.progress = [pending](const Progress& p) { pending->beat(&p); };
   rq.progress_interval = 0.1;
@@ -153,15 +179,38 @@ PYBIND11_MODULE(_rfem, m) {
   m.attr("build") = build_description();
   py::register_exception<CaseError>(m, "CaseError", PyExc_ValueError);
   py::register_exception<ResultsError>(m, "ResultsError", PyExc_OSError);
+  m.attr("MAX_RFES") = kMaxRfes;  // the most rfes n may ask for (the case file's limit)
+
+  py::class_<RunStatus>(m, "RunStatus", "How a run ended, parsed from its status text (RunStatus.parse(run.status)).")
+      .def_static("parse", [](py::handle text) { return RunStatus::parse(args::text(text, "text")); }, py::arg("text"),
+                  "'running', 'completed', 'interrupted (signal N)', 'failed: why'; other text is a failure with it as reason")
+      .def_property_readonly("kind", [](const RunStatus& s) {
+        switch (s.kind) {
+          case RunStatus::Kind::Running: return "running";
+          case RunStatus::Kind::Completed: return "completed";
+          case RunStatus::Kind::Interrupted: return "interrupted";
+          case RunStatus::Kind::Failed: break;
+        }
+        return "failed";
+      }, "running, completed, interrupted or failed")
+      .def_property_readonly("completed", &RunStatus::is_completed)
+      .def_readonly("signal", &RunStatus::signal, "interrupted: the signal that asked for the stop (0: a caller's stop)")
+      .def_readonly("reason", &RunStatus::reason, "failed: why")
+      .def("__str__", &RunStatus::to_string)
+      .def("__repr__", [](const RunStatus& s) { return "<rfem.RunStatus " + s.to_string() + ">"; });
 
   py::class_<Case>(m, "Case", "A case: a TOML case file as read and checked (rfem.load, rfem.Case.from_text).")
-      .def_static("load", &read_case, py::arg("path"), py::arg("overrides") = std::vector<std::string>{},
-                  "Reads and checks a case file; overrides are 'key.path=value' strings (as rfem --set).")
-      .def_static("from_text", &parse_case, py::arg("text"), py::arg("name") = "<text>",
-                  py::arg("overrides") = std::vector<std::string>{}, py::arg("base_dir") = "",
-                  "A case from TOML text; `name` stands for the file in messages, table files are found in base_dir.")
-      .def("with_overrides", &with_overrides, py::arg("overrides"),
-           "The case with more 'key.path=value' overrides, read and checked again (CaseError names the key).")
+      .def_static("load", [](py::handle path, py::handle overrides) {
+        return read_case(args::path(path, "path"), args::texts(overrides, "overrides"));
+      }, py::arg("path"), py::arg("overrides") = py::tuple(),
+         "Reads and checks a case file; overrides are 'key.path=value' strings (as rfem --set).")
+      .def_static("from_text", [](py::handle text, py::handle name, py::handle overrides, py::handle base_dir) {
+        return parse_case(args::text(text, "text"), args::text(name, "name"), args::texts(overrides, "overrides"),
+                          args::path(base_dir, "base_dir", true));
+      }, py::arg("text"), py::arg("name") = "<text>", py::arg("overrides") = py::tuple(), py::arg("base_dir") = "",
+         "A case from TOML text; `name` stands for the file in messages, table files are found in base_dir.")
+      .def("with_overrides", [](const Case& c, py::handle overrides) { return with_overrides(c, args::texts(overrides, "overrides")); },
+           py::arg("overrides"), "The case with more 'key.path=value' overrides, read and checked again (CaseError names the key).")
       .def_readonly("path", &Case::path)
       .def_readonly("text", &Case::text, "the case file as read")
       .def_readonly("effective_text", &Case::effective_text, "the case after its overrides, as TOML")
@@ -205,8 +254,8 @@ PYBIND11_MODULE(_rfem, m) {
       .def("__repr__", [](const Model& md) {
         return "<rfem.Model n=" + std::to_string(md.n()) + " rfes, m=" + std::to_string(md.m()) + " joints>";
       });
-  m.def("model", [](const Case& c, int n) { return std::const_pointer_cast<Model>(model_of(c, n)); }, py::arg("case"),
-        py::arg("n") = 0, "The case's model with n rfes in all (0: the case's own discretisation).");
+  m.def("model", [](py::handle c, py::handle n) { return std::const_pointer_cast<Model>(model_of(*args::CaseArg(c), args::rfes(n))); },
+        py::arg("case"), py::arg("n") = py::none(), "The case's model with n rfes in all (None: the case's own discretisation).");
 
   py::class_<RunResult, std::shared_ptr<RunResult>>(m, "Run", "One run of a study: status, statistics, peaks and series.")
       .def_readonly("name", &RunResult::name)
@@ -228,12 +277,15 @@ PYBIND11_MODULE(_rfem, m) {
       .def_property_readonly("names", [](const RunResult& r) {
         return r.series ? r.series->names() : std::vector<std::string>{};
       }, "the series kept (empty if the run kept none)")
-      .def("table", [](const std::shared_ptr<RunResult>& r, const std::string& name) {
+      .def("table", [](const std::shared_ptr<RunResult>& r, py::handle series) {
+        const std::string name = args::text(series, "name");
         if (!r->series) throw py::value_error("the run kept no series (keep_series=False)");
         const RunSeries::View v = r->series->view(name);
         return view(std::shared_ptr<const RunSeries>(r->series), v.data, v.rows, v.info->width());
       }, py::arg("name"), "Series `name` (rows = outputs) as a read-only array, e.g. 'joint_tau', 'links/upper/tip_deflection'.")
-      .def("column", [](const std::shared_ptr<RunResult>& r, const std::string& name, int col) {
+      .def("column", [](const std::shared_ptr<RunResult>& r, py::handle series, py::handle column) {
+        const std::string name = args::text(series, "name");
+        const long col = args::integer(column, "column", 0, INT_MAX, "a column number, 0 or more");
         if (!r->series) throw py::value_error("the run kept no series (keep_series=False)");
         const RunSeries::View v = r->series->view(name);
         if (col < 0 || col >= v.info->width()) throw py::index_error("no column " + std::to_string(col) + " in " + name);
@@ -246,7 +298,8 @@ PYBIND11_MODULE(_rfem, m) {
         a.attr("flags").attr("writeable") = false;
         return a;
       }, py::arg("name"), py::arg("column"), "One column of a series as a read-only 1-D array.")
-      .def("info", [](const RunResult& r, const std::string& name) {
+      .def("info", [](const RunResult& r, py::handle series) {
+        const std::string name = args::text(series, "name");
         if (!r.series) throw py::value_error("the run kept no series (keep_series=False)");
         const SeriesInfo& i = *r.series->view(name).info;
         return py::dict(py::arg("name") = i.name, py::arg("columns") = i.columns, py::arg("units") = i.units,
@@ -256,13 +309,17 @@ PYBIND11_MODULE(_rfem, m) {
         return "<rfem.Run " + r.name + ": " + r.status.to_string() + ", " + std::to_string(r.samples) + " outputs>";
       });
 
-  m.def("_run", [](const Case& cs, int n, const std::string& output, const std::vector<std::string>& runs, int threads,
-                   bool keep_series, py::object progress, double checkpoint) {
+  m.def("_run", [](py::handle case_arg, py::handle n_arg, py::handle output_arg, py::handle runs, py::handle threads,
+                   py::handle keep_series, py::handle progress, py::handle checkpoint) {
+    const args::CaseArg cs_arg(case_arg);
+    const Case& cs = *cs_arg;
+    const int n = args::rfes(n_arg);
+    const std::string output = args::path(output_arg, "output", true);
     auto pending = std::make_shared<Pending>();
     std::vector<std::string> warnings;
-    RunRequest rq = python_request(pending, std::move(progress), threads, keep_series, checkpoint, warnings);
+    RunRequest rq = python_request(pending, progress, threads, keep_series, checkpoint, warnings);
     rq.n = n;
-    rq.runs = run_names(runs);
+    rq.runs = run_names(args::texts(runs, "runs"));
     std::vector<RunResult> results;
     {
       py::gil_scoped_release release;
@@ -274,7 +331,7 @@ PYBIND11_MODULE(_rfem, m) {
       std::unique_ptr<Hdf5Recorder> recorder;
       if (!output.empty()) {
         Parallelism p;
-        p.threads = threads;
+        p.threads = rq.threads;
         file = std::make_unique<ResultsWriter>(
             output, python_description(cs, "rfem.run", to_string(cs.sim.procedure), model->n(), p.max_threads(), n));
         recorder = std::make_unique<Hdf5Recorder>(*file);
@@ -296,10 +353,11 @@ PYBIND11_MODULE(_rfem, m) {
 
   m.attr("CHECKPOINT_INTERVAL") = kCheckpointInterval;
 
-  m.def("_resume", [](const std::string& path, int threads, bool keep_series, py::object progress, double checkpoint) {
+  m.def("_resume", [](py::handle path_arg, py::handle threads, py::handle keep_series, py::handle progress, py::handle checkpoint) {
+    const std::string path = args::path(path_arg, "resume");
     auto pending = std::make_shared<Pending>();
     std::vector<std::string> warnings;
-    RunRequest rq = python_request(pending, std::move(progress), threads, keep_series, checkpoint, warnings);
+    RunRequest rq = python_request(pending, progress, threads, keep_series, checkpoint, warnings);
     std::vector<RunResult> results;
     std::vector<std::string> done;
     {
@@ -316,15 +374,17 @@ PYBIND11_MODULE(_rfem, m) {
     return py::make_tuple(out, error, warnings, done);
   }, py::arg("path"), py::arg("threads"), py::arg("keep_series"), py::arg("progress"), py::arg("checkpoint"));
 
-  m.def("write_xdmf", [](const std::string& results, const std::vector<std::string>& runs) {
+  m.def("write_xdmf", [](py::handle results_arg, py::handle runs_arg) {
+    const std::string results = args::path(results_arg, "results");
+    const std::vector<std::string> runs = args::texts(runs_arg, "runs");
     py::gil_scoped_release release;
     return write_xdmf(results, runs);
-  }, py::arg("results"), py::arg("runs") = std::vector<std::string>{},
+  }, py::arg("results"), py::arg("runs") = py::tuple(),
      "ParaView (XDMF 2) files beside a results file for every run (or `runs`) that stored its poses "
      "(simulation.store_flexible_every > 0); returns the paths written. rfem view RESULTS.h5 does the same.");
 
-  m.def("_show", [](const Case& cs, int n) {
-    const ModelSummary s = show_model(cs, n);
+  m.def("_show", [](py::handle cs, py::handle n) {
+    const ModelSummary s = show_model(*args::CaseArg(cs), args::rfes(n));
     py::list entries;
     for (const TreeEntry& e : s.entries)
       entries.append(py::dict(py::arg("kind") = e.kind, py::arg("name") = e.name, py::arg("depth") = e.depth,
@@ -354,9 +414,12 @@ PYBIND11_MODULE(_rfem, m) {
         return d;
       }, "per link: its free end's displacement [m] and rotation [rad] in its {r}")
       .def_property_readonly("model", [](const StaticStudy& s) { return std::const_pointer_cast<Model>(s.model); });
-  m.def("_static", [](const Case& cs, int n, std::optional<double> rate, int joint) {
+  m.def("_static", [](py::handle case_arg, py::handle n_arg, py::handle rate, py::handle joint) {
+    const args::CaseArg cs(case_arg);
+    const int n = args::rfes(n_arg);
+    const JointRate r = joint_rate(rate, joint);
     py::gil_scoped_release release;
-    return std::make_shared<StaticStudy>(static_study(cs, n, joint_rate(rate, joint)));
+    return std::make_shared<StaticStudy>(static_study(*cs, n, r));
   }, py::arg("case"), py::arg("n"), py::arg("rate"), py::arg("joint"));
 
   py::class_<ModesStudy, std::shared_ptr<ModesStudy>>(m, "ModesResult", "Natural frequencies and mode shapes (rfem.modes).")
@@ -386,13 +449,16 @@ PYBIND11_MODULE(_rfem, m) {
       }, "per mode, for one uniform segment: the exact value it converges to")
       .def_readonly("warnings", &ModesStudy::warnings)
       .def_property_readonly("model", [](const ModesStudy& s) { return std::const_pointer_cast<Model>(s.model); });
-  m.def("_modes", [](const Case& cs, int n, int count, const std::vector<std::string>& free, std::optional<double> rate,
-                     int joint, const std::string& output) {
+  m.def("_modes", [](py::handle case_arg, py::handle n, py::handle count, py::handle free, py::handle rate, py::handle joint,
+                     py::handle output_arg) {
+    const args::CaseArg cs_arg(case_arg);
+    const Case& cs = *cs_arg;
     ModesRequest rq;
-    rq.n = n;
-    rq.count = count;
-    rq.free = free;
+    rq.n = args::rfes(n);
+    rq.count = args::positive(count, "count");
+    rq.free = free_joints(free);
     rq.rate = joint_rate(rate, joint);
+    const std::string output = args::path(output_arg, "output", true);
     py::gil_scoped_release release;
     auto s = std::make_shared<ModesStudy>(modes_study(cs, rq));
     if (!output.empty()) {
@@ -403,17 +469,20 @@ PYBIND11_MODULE(_rfem, m) {
     return s;
   }, py::arg("case"), py::arg("n"), py::arg("count"), py::arg("free"), py::arg("rate"), py::arg("joint"), py::arg("output"));
 
-  m.def("_refine", [](const Case& cs, const std::vector<int>& ns, const std::vector<std::string>& quantities,
-                      const std::string& output, bool integration_check, std::optional<double> rate, int joint, int threads,
-                      py::object progress) {
+  m.def("_refine", [](py::handle case_arg, py::handle ns, py::handle quantity_args, py::handle output_arg,
+                      py::handle integration_check, py::handle rate, py::handle joint, py::handle threads, py::handle progress) {
+    const args::CaseArg cs_arg(case_arg);
+    const Case& cs = *cs_arg;
+    const std::vector<std::string> quantities = args::texts(quantity_args, "quantities");
+    const std::string output = args::path(output_arg, "output", true);
     auto pending = std::make_shared<Pending>();
-    pending->progress = std::move(progress);
+    pending->progress = args::callback(progress, "progress");
     RefineRequest rq;
-    rq.ns = ns;
+    rq.ns = args::rfes_list(ns, "ns");
     rq.quantities = quantities;
-    rq.integration_check = integration_check;
+    rq.integration_check = args::flag(integration_check, "integration_check");
     rq.rate = joint_rate(rate, joint);
-    rq.threads = threads;
+    rq.threads = args::threads(threads);
     rq.stop = pending->stop;
     rq.progress = [pending](const Progress& p) { pending->beat(&p); };
     rq.on_n = [pending](int, int, int) { pending->beat(nullptr); };
@@ -427,7 +496,7 @@ PYBIND11_MODULE(_rfem, m) {
       std::unique_ptr<Hdf5Recorder> recorder;
       if (!output.empty()) {
         Parallelism p;
-        p.threads = threads;
+        p.threads = rq.threads;
         file = std::make_unique<ResultsWriter>(output, python_description(cs, "rfem.refine", "refine", -1, p.max_threads()));
         recorder = std::make_unique<Hdf5Recorder>(*file);
         rq.observers.push_back(recorder.get());

@@ -9,11 +9,13 @@
 #include <csignal>
 #include <memory>
 
+#include "arguments.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/simulation.hpp"
 
 namespace py = pybind11;
 using namespace rfem;
+namespace args = rfem::pyargs;
 
 namespace {
 
@@ -59,13 +61,14 @@ py::dict snapshot_dict(const Snapshot& y, const Model& model) {
   return d;
 }
 
-SimulationOptions options(int n, int threads, const std::string& output, bool keep_series,
+// The options of rfem.Simulation and rfem.run_controlled, their arguments checked (arguments.hpp).
+SimulationOptions options(py::handle n, py::handle threads, py::handle output, py::handle keep_series,
                           std::optional<SimulationState> state, const std::string& made_by, const std::shared_ptr<Poll>& poll) {
   SimulationOptions o;
-  o.n = n;
-  o.threads = threads;
-  o.output = output;
-  o.keep_series = keep_series;
+  o.n = args::rfes(n);
+  o.threads = args::threads(threads);
+  o.output = args::path(output, "output", true);
+  o.keep_series = args::flag(keep_series, "keep_series");
   o.made_by = made_by;
   if (state) o.state = std::make_shared<const SimulationState>(std::move(*state));
   o.stop = poll->stop;
@@ -115,9 +118,9 @@ void bind_simulation(py::module_& m) {
       .def("pack", [](const SimulationState& s) { const auto x = s.pack(); return py::array_t<double>(x.size(), x.data()); },
            "the state as one float64 array (with .model, what unpack takes)")
       .def_static("unpack", &SimulationState::unpack, py::arg("model"), py::arg("packed"))
-      .def("save", [](const SimulationState& s, const std::string& path) { save_state(s, path); }, py::arg("path"),
+      .def("save", [](const SimulationState& s, py::handle path) { save_state(s, args::path(path, "path")); }, py::arg("path"),
            "into an HDF5 file of its own (state/packed, state/model)")
-      .def_static("load", &load_state, py::arg("path"))
+      .def_static("load", [](py::handle path) { return load_state(args::path(path, "path")); }, py::arg("path"))
       .def(py::pickle([](const SimulationState& s) { return py::make_tuple(s.model, s.pack()); },
                       [](const py::tuple& t) {
                         if (t.size() != 2) throw std::invalid_argument("not a pickled SimulationState");
@@ -132,12 +135,13 @@ void bind_simulation(py::module_& m) {
     std::unique_ptr<Simulation> sim;
   };
   py::class_<PySimulation>(m, "_Simulation")
-      .def(py::init([](const Case& cs, int n, int threads, const std::string& output, bool keep_series,
+      .def(py::init([](py::handle case_arg, py::handle n, py::handle threads, py::handle output, py::handle keep_series,
                        std::optional<SimulationState> state, const std::string& made_by) {
+             const args::CaseArg cs(case_arg);
              auto p = std::make_unique<PySimulation>();
              SimulationOptions o = options(n, threads, output, keep_series, std::move(state), made_by, p->poll);
              py::gil_scoped_release release;
-             p->sim = std::make_unique<Simulation>(cs, std::move(o));
+             p->sim = std::make_unique<Simulation>(*cs, std::move(o));
              return p;
            }),
            py::arg("case"), py::arg("n"), py::arg("threads"), py::arg("output"), py::arg("keep_series"), py::arg("state"),
@@ -152,10 +156,15 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("status", [](const PySimulation& p) { return p.sim->status().to_string(); })
       .def_property_readonly("finished", [](const PySimulation& p) { return p.sim->finished(); })
       .def_property_readonly("output", [](const PySimulation& p) { return p.sim->output(); })
-      .def("set_torque", [](PySimulation& p, const std::string& j, double tau) { p.sim->set_torque(j, tau); })
-      .def("set_reference", [](PySimulation& p, const std::string& j, double q, double v, double ff) { p.sim->set_reference(j, q, v, ff); })
-      .def("release", [](PySimulation& p, const std::string& j) { p.sim->release(j); })
-      .def("advance", [](PySimulation& p, double t) {
+      .def("set_torque", [](PySimulation& p, py::handle j, py::handle tau) {
+        p.sim->set_torque(args::text(j, "joint"), args::real(tau, "tau", "a finite torque [N m] or force [N]"));
+      })
+      .def("set_reference", [](PySimulation& p, py::handle j, py::handle q, py::handle v, py::handle ff) {
+        p.sim->set_reference(args::text(j, "joint"), args::real(q, "q"), args::real(v, "qd"), args::real(ff, "tau_ff"));
+      })
+      .def("release", [](PySimulation& p, py::handle j) { p.sim->release(args::text(j, "joint")); })
+      .def("advance", [](PySimulation& p, py::handle time) {
+        const double t = args::real(time, "t", "a finite time [s]");
         RunStatus s;
         {
           py::gil_scoped_release release;
@@ -176,9 +185,12 @@ void bind_simulation(py::module_& m) {
         return r;
       });
 
-  m.def("_run_controlled", [](const Case& cs, int n, int threads, const std::string& output, bool keep_series,
+  m.def("_run_controlled", [](py::handle case_arg, py::handle n, py::handle threads, py::handle output, py::handle keep_series,
                               std::optional<SimulationState> state, const std::string& made_by, py::object controller,
-                              double sample_time, int delay) {
+                              py::handle sample_time, py::handle delay) {
+    const args::CaseArg cs_arg(case_arg);
+    const Case& cs = *cs_arg;
+    if (!PyCallable_Check(controller.ptr())) args::type_error("controller", "callable f(t, y)", controller);
     auto poll = std::make_shared<Poll>();
     SimulationOptions o = options(n, threads, output, keep_series, std::move(state), made_by, poll);
     const std::vector<std::string> kinds = input_kinds(joint_inputs(cs));
@@ -232,12 +244,12 @@ void bind_simulation(py::module_& m) {
       return u;
     };
     ControlOptions c;
-    c.sample_time = sample_time;
-    c.delay = delay;
+    c.sample_time = args::real(sample_time, "sample_time", "a finite time [s]");
+    c.delay = static_cast<int>(args::integer(delay, "delay", 0, INT_MAX, "a number of samples, 0 or more"));
     std::shared_ptr<RunResult> result;
     {
       py::gil_scoped_release release;
-      model = model_of(cs, n);  // (the snapshot's names; the same as the run's model)
+      model = model_of(cs, o.n);  // (the snapshot's names; the same as the run's model)
       result = std::make_shared<RunResult>(run_controlled(cs, std::move(o), f, c));
     }
     // A non-finite value the C++ loop refused is a ValueError too.

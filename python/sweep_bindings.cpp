@@ -7,20 +7,44 @@
 
 #include <atomic>
 #include <chrono>
+#include <climits>
 #include <csignal>
 #include <mutex>
 #include <thread>
+#include <type_traits>
 
+#include "arguments.hpp"
+#include "rfem/solvers/run_status.hpp"
 #include "rfem/studies/sweep.hpp"
 
 namespace py = pybind11;
 using namespace rfem;
+namespace args = rfem::pyargs;
 
 namespace {
 
+const Sweep& sweep_of(py::handle v) { return args::object<Sweep>(v, "sweep", "an rfem.Sweep (rfem.load_sweep)"); }
+
+// Point k of the sweep: 0 to its size - 1.
+int point(const Sweep& s, py::handle k) {
+  if (s.points.empty()) throw py::value_error("k: the sweep has no points");
+  return static_cast<int>(args::integer(k, "k", 0, static_cast<long>(s.points.size()) - 1,
+                                        "a point of the sweep, 0 to " + std::to_string(s.points.size() - 1)));
+}
+
+// A row's status as text, whether the library keeps it as text or as a RunStatus (issue #34 moves it).
+template <class S>
+std::string status_text(const S& s) {
+  if constexpr (std::is_same_v<S, std::string>) return s; else return s.to_string();
+}
+template <class S>
+void set_status(S& s, const std::string& text) {
+  if constexpr (std::is_same_v<S, std::string>) s = text; else s = RunStatus::parse(text);
+}
+
 py::dict row_dict(const SweepRow& r) {
   py::dict d;
-  d["status"] = r.status;
+  d["status"] = status_text(r.status);
   d["wall_s"] = r.wall_s;
   d["t_reached"] = r.t_reached;
   d["steps"] = r.steps;
@@ -29,14 +53,32 @@ py::dict row_dict(const SweepRow& r) {
   return d;
 }
 
-SweepRow dict_row(const py::dict& d) {
+// A row as run_point returns it, its entries checked (TypeError/ValueError naming rows[k]["key"]).
+SweepRow dict_row(py::handle row, const std::string& name) {
+  if (!py::isinstance<py::dict>(row)) args::type_error(name, "a dict (a row as run_point returns it)", row);
+  const py::dict d = py::reinterpret_borrow<py::dict>(row);
+  if (!d.contains("status")) throw py::value_error(name + ": has no \"status\"");
+  auto key = [&](const char* k) { return name + "[\"" + k + "\"]"; };
+  auto number = [&](const char* k) {  // NaN: not known
+    if (!d.contains(k)) return static_cast<double>(NAN);
+    const py::handle v = d[k];
+    if (PyBool_Check(v.ptr()) || !(PyFloat_Check(v.ptr()) || PyIndex_Check(v.ptr()))) args::type_error(key(k), "a number", v);
+    return py::float_(py::reinterpret_borrow<py::object>(v)).cast<double>();
+  };
   SweepRow r;
-  r.status = d["status"].cast<std::string>();
-  r.wall_s = d.contains("wall_s") ? d["wall_s"].cast<double>() : NAN;
-  r.t_reached = d.contains("t_reached") ? d["t_reached"].cast<double>() : NAN;
-  r.steps = d.contains("steps") ? d["steps"].cast<long>() : 0;
-  r.residual_evals = d.contains("residual_evals") ? d["residual_evals"].cast<long>() : 0;
-  if (d.contains("values")) r.values = d["values"].cast<std::vector<double>>();
+  set_status(r.status, args::text(d["status"], key("status")));
+  r.wall_s = number("wall_s");
+  r.t_reached = number("t_reached");
+  r.steps = d.contains("steps") ? args::integer(d["steps"], key("steps"), 0, LONG_MAX, "a count, 0 or more") : 0;
+  r.residual_evals = d.contains("residual_evals") ? args::integer(d["residual_evals"], key("residual_evals"), 0, LONG_MAX, "a count, 0 or more") : 0;
+  if (d.contains("values")) {
+    const py::handle v = d["values"];
+    if (PyUnicode_Check(v.ptr()) || !py::isinstance<py::iterable>(v)) args::type_error(key("values"), "a list of numbers", v);
+    for (py::handle x : py::reinterpret_borrow<py::iterable>(v)) {
+      if (PyBool_Check(x.ptr()) || !(PyFloat_Check(x.ptr()) || PyIndex_Check(x.ptr()))) args::type_error(key("values"), "a list of numbers", x);
+      r.values.push_back(py::float_(py::reinterpret_borrow<py::object>(x)).cast<double>());  // NaN: not reached
+    }
+  }
   return r;
 }
 
@@ -59,9 +101,13 @@ void bind_sweep(py::module_& m) {
       })
       .def("__len__", [](const Sweep& s) { return s.points.size(); });
 
-  m.def("load_sweep", &read_sweep, py::arg("path"), py::arg("output") = "",
-        "Reads a sweep file and checks every point (CaseError as rfem sweep prints it).");
-  m.def("run_point", [](const Sweep& s, int k, int threads) {
+  m.def("load_sweep", [](py::handle path, py::handle output) {
+    return read_sweep(args::path(path, "path"), args::path(output, "output", true));
+  }, py::arg("path"), py::arg("output") = "", "Reads a sweep file and checks every point (CaseError as rfem sweep prints it).");
+  m.def("run_point", [](py::handle sweep, py::handle k_arg, py::handle threads_arg) {
+    const Sweep& s = sweep_of(sweep);
+    const int k = point(s, k_arg);
+    const int threads = args::threads(threads_arg);
     SweepRow r;
     {
       py::gil_scoped_release release;
@@ -70,21 +116,26 @@ void bind_sweep(py::module_& m) {
     return row_dict(r);
   }, py::arg("sweep"), py::arg("k"), py::arg("threads") = 1,
      "Runs point k into its file; returns its row {status, wall_s, t_reached, steps, residual_evals, values}.");
-  m.def("finished_point", [](const Sweep& s, int k) -> py::object {
-    const auto r = finished_point(s, k);
+  m.def("finished_point", [](py::handle sweep, py::handle k) -> py::object {
+    const Sweep& s = sweep_of(sweep);
+    const auto r = finished_point(s, point(s, k));
     return r ? py::object(row_dict(*r)) : py::none();
   }, py::arg("sweep"), py::arg("k"), "Point k's row if its file holds a finished run of it, else None.");
-  m.def("write_index", [](const Sweep& s, const std::vector<py::dict>& rows) {
+  m.def("write_index", [](py::handle sweep, py::handle rows) {
+    const Sweep& s = sweep_of(sweep);
+    if (PyUnicode_Check(rows.ptr()) || !py::isinstance<py::iterable>(rows)) args::type_error("rows", "a list of dicts (run_point's rows)", rows);
     std::vector<SweepRow> rs;
-    for (const py::dict& d : rows) rs.push_back(dict_row(d));
+    for (py::handle d : py::reinterpret_borrow<py::iterable>(rows)) rs.push_back(dict_row(d, "rows[" + std::to_string(rs.size()) + "]"));
     py::gil_scoped_release release;
     write_index(s, rs);
   }, py::arg("sweep"), py::arg("rows"), "Writes the index from one row per point (dicts as run_point returns).");
 
-  m.def("_sweep", [](const Sweep& s, int jobs, bool retry_failed, py::object progress) {
+  m.def("_sweep", [](py::handle sweep, py::handle jobs, py::handle retry_failed, py::handle progress_arg) {
+    const Sweep& s = sweep_of(sweep);
+    const py::object progress = args::callback(progress_arg, "progress");
     SweepRequest rq;
-    rq.jobs = jobs;
-    rq.retry_failed = retry_failed;
+    rq.jobs = static_cast<int>(args::integer(jobs, "jobs", 0, INT_MAX, "0 (the cores) or a positive integer"));
+    rq.retry_failed = args::flag(retry_failed, "retry_failed");
     std::mutex lock;
     SweepProgress last;
     bool fresh = false;

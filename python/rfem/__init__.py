@@ -14,7 +14,9 @@ The same operations as the `rfem` program, from Python, with the same checks and
 
 Errors in a case are `rfem.CaseError` (a ValueError) with the program's one-line message
 ("FILE:LINE: key: what is wrong"); a results file that cannot be written is `rfem.ResultsError`
-(an OSError). Ctrl-C during a run stops it within a step and raises `rfem.RunInterrupted` (a
+(an OSError). An argument of the wrong type is a TypeError, a wrong value a ValueError, one line
+naming it ("n: must be a positive integer up to 10000000 (got 0)"); a case argument is an rfem.Case
+or a case file's path. Ctrl-C during a run stops it within a step and raises `rfem.RunInterrupted` (a
 KeyboardInterrupt) whose `.result` holds the runs so far. Long calls release the GIL.
 Units are SI; the results layout is README.md's "Results (HDF5)".
 """
@@ -25,10 +27,10 @@ import subprocess as _subprocess
 import sys as _sys
 
 from . import _rfem
-from ._rfem import (Case, CaseError, Model, ModesResult, ResultsError, Run, StaticResult, Sweep, __version__, build,
-                    finished_point, run_point, write_index, write_xdmf)
+from ._rfem import (MAX_RFES, Case, CaseError, Model, ModesResult, ResultsError, Run, RunStatus, StaticResult, Sweep,
+                    __version__, build, finished_point, run_point, write_index, write_xdmf)
 
-__all__ = ["Case", "CaseError", "Model", "ModesResult", "ResultsError", "Run", "RunInterrupted", "Runs",
+__all__ = ["Case", "CaseError", "Model", "ModesResult", "ResultsError", "Run", "RunInterrupted", "RunStatus", "Runs",
            "StaticResult", "RefineResult", "Tree", "load", "model", "show", "run", "static", "modes", "refine", "plot",
            "write_xdmf", "animate", "toml_value", "__version__", "Sweep", "SweepResult", "load_sweep", "sweep", "run_point",
            "finished_point", "write_index"]
@@ -81,13 +83,13 @@ Case.with_values = _with_values
 def load(path, values=None, overrides=()):
     """Reads and checks a case file (TOML). `values`: {path: value} as in Case.with_values;
     `overrides`: 'key.path=value' strings as given to `rfem --set`."""
-    case = Case.load(_os.fspath(path), list(overrides))
+    case = Case.load(path, overrides)
     return case.with_values(values) if values else case
 
 
 def model(case, n=None):
     """The case's Model with n rfes in all links (None: the case's own discretisation)."""
-    return _rfem.model(case, n or 0)
+    return _rfem.model(case, n)
 
 
 class Runs(list):
@@ -141,7 +143,7 @@ def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, 
     if resume is not None:
         if case is not None or n is not None or output is not None or runs is not None:
             raise ValueError("rfem.run(resume=...) takes no case, n, output or runs: the results file has them")
-        out, error, warnings, kept = _rfem._resume(_os.fspath(resume), threads, keep_series, progress, checkpoint)
+        out, error, warnings, kept = _rfem._resume(resume, threads, keep_series, progress, checkpoint)
         result = Runs(out)
         result.warnings = warnings
         result.kept = kept
@@ -149,8 +151,7 @@ def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, 
         return result
     if case is None:
         raise ValueError("rfem.run needs a case (or resume=RESULTS.h5)")
-    out, error, warnings = _rfem._run(case, n or 0, _os.fspath(output) if output else "", list(runs or []),
-                                      threads, keep_series, progress, checkpoint)
+    out, error, warnings = _rfem._run(case, n, output, runs, threads, keep_series, progress, checkpoint)
     result = Runs(out)
     result.warnings = warnings
     _raise(error, result)
@@ -175,7 +176,7 @@ class Tree(list):
 def show(case, n=None):
     """What the case builds, to check against its drawing: every joint, link and payload with
     what it is mounted on and where, masses, rfes, coordinates and inputs. print(rfem.show(case))."""
-    text, entries, urdf, frames = _rfem._show(case, n or 0)
+    text, entries, urdf, frames = _rfem._show(case, n)
     tree = Tree(entries)
     tree.text, tree.urdf, tree.frames = text, urdf, frames
     return tree
@@ -185,7 +186,7 @@ def static(case, n=None, rate=None, joint=1):
     """Static equilibrium with the joints held at their values (or turning steadily: `rate`
     [rad/s or m/s] of joint `joint`, from 1) under gravity and the case's tip loads. Returns a
     StaticResult (tips per link, energies, coordinates)."""
-    return _rfem._static(case, n or 0, rate, joint)
+    return _rfem._static(case, n, rate, joint)
 
 
 def modes(case, n=None, count=6, free=(), rate=None, joint=1, output=None):
@@ -194,7 +195,7 @@ def modes(case, n=None, count=6, free=(), rate=None, joint=1, output=None):
     turning at `rate` about joint `joint`. Returns a ModesResult (frequencies [Hz], kinds,
     shapes, exact references for one uniform segment); `output`: an HDF5 file with the
     frequencies and shapes (group modes, as `rfem modes -o`)."""
-    return _rfem._modes(case, n or 0, count, [str(f) for f in free], rate, joint, _os.fspath(output) if output else "")
+    return _rfem._modes(case, n, count, free, rate, joint, output)
 
 
 class RefineResult(dict):
@@ -214,10 +215,7 @@ def refine(case, ns, quantities, output=None, integration_check=True, rate=None,
     (the quantities of `rfem refine`: "tip:uz", "bending-y:1", "peak:u1", "force/u1@10", …).
     Dynamic quantities share one run per n; `output` keeps every run and the tables in HDF5.
     Ctrl-C raises RunInterrupted with the rows done in .result."""
-    if isinstance(quantities, str):
-        quantities = [quantities]
-    out, error = _rfem._refine(case, list(ns), list(quantities), _os.fspath(output) if output else "", integration_check,
-                               rate, joint, threads, progress)
+    out, error = _rfem._refine(case, ns, quantities, output, integration_check, rate, joint, threads, progress)
     result = RefineResult(out)
     _raise(error, result)
     return result
@@ -238,7 +236,7 @@ class SweepResult(dict):
 
     @property
     def completed(self):
-        return all(s == "completed" for s in self["status"])
+        return all(RunStatus.parse(s).completed for s in self["status"])
 
     warnings = ()
 
@@ -247,7 +245,7 @@ def load_sweep(path, output=None):
     """Reads a sweep file and checks every point before anything runs; returns a Sweep (its
     .points: overrides, values, file, cost) for rfem.sweep or for your own scheduler
     (rfem.run_point(sweep, k) in any process or pool, then rfem.write_index(sweep, rows))."""
-    return _rfem.load_sweep(_os.fspath(path), _os.fspath(output) if output else "")
+    return _rfem.load_sweep(path, output)
 
 
 def sweep(path, output=None, jobs=0, retry_failed=False, progress=None):

@@ -11,39 +11,12 @@
 The library's studies/simulation.hpp does the work; see README.md, "Control in the loop".
 """
 
-import math as _math
 import os as _os
 
 from . import _rfem
 from ._rfem import SimulationState
 
 __all__ = ["Simulation", "SimulationState", "run_controlled", "load_state"]
-
-
-def _case(case):
-    if isinstance(case, _rfem.Case):
-        return case
-    if isinstance(case, (str, bytes, _os.PathLike)):
-        return _rfem.Case.load(_os.fsdecode(case))
-    raise TypeError(f"case must be an rfem.Case or a path, not {type(case).__name__}")
-
-
-def _n(n):
-    if n is None:
-        return 0
-    if isinstance(n, bool) or not isinstance(n, int):
-        raise TypeError(f"n must be a whole number of rfes, not {type(n).__name__}")
-    if n < 1:
-        raise ValueError(f"n = {n}: must be at least 1 rfe (None: the case's own)")
-    return n
-
-
-def _threads(threads):
-    if isinstance(threads, bool) or not isinstance(threads, int):
-        raise TypeError(f"threads must be a whole number, not {type(threads).__name__}")
-    if threads < 0:
-        raise ValueError(f"threads = {threads}: must be 0 (all cores) or more")
-    return threads
 
 
 def _state(state):
@@ -87,8 +60,8 @@ class Simulation:
     Not thread-safe: one thread steps a simulation."""
 
     def __init__(self, case, n=None, output=None, state=None, threads=0, keep_series=True):
-        self._sim = _rfem._Simulation(_case(case), _n(n), _threads(threads), _os.fspath(output) if output else "",
-                                      bool(keep_series), _state(state), "rfem.Simulation (Python)")
+        # (the arguments are checked by the module: TypeError, ValueError naming them)
+        self._sim = _rfem._Simulation(case, n, threads, output, keep_series, _state(state), "rfem.Simulation (Python)")
 
     time = property(lambda self: self._sim.time, doc="where the simulation is [s]")
     t_end = property(lambda self: self._sim.t_end, doc="the case's simulation.t_end [s]: advance() goes no further")
@@ -103,20 +76,18 @@ class Simulation:
     def advance(self, t):
         """Integrates to t [s] (time ≤ t ≤ t_end), the last step ending exactly at t; returns the
         status. Ctrl-C raises RunInterrupted (the rows so far are kept)."""
-        if isinstance(t, bool) or not isinstance(t, (int, float)) or not _math.isfinite(t):
-            raise TypeError(f"advance: t must be a finite number of seconds, got {t!r}")
-        status, error = self._sim.advance(float(t))
+        status, error = self._sim.advance(t)
         if error is not None:
             _raise_interrupt(error, self._sim.finish())
         return status
 
     def set_torque(self, joint, tau):
         """Holds torque (force) tau [N m or N] on a force-input joint from now on (zero-order hold)."""
-        self._sim.set_torque(joint, float(tau))
+        self._sim.set_torque(joint, tau)
 
     def set_reference(self, joint, q, qd=0.0, tau_ff=0.0):
         """Holds the reference of a PD joint: tau = tau_ff + kp (q - joint q) + kd (qd - joint qd)."""
-        self._sim.set_reference(joint, float(q), float(qd), float(tau_ff))
+        self._sim.set_reference(joint, q, qd, tau_ff)
 
     def release(self, joint):
         """The joint follows the case's own law again."""
@@ -155,15 +126,8 @@ def run_controlled(case, controller, sample_time, n=None, delay=0, output=None, 
     controller's outputs are in the results file's run/control. An exception in the controller ends
     the run "failed: controller: …" (rows kept); a return that is not a dict of finite numbers by
     known joints raises TypeError or ValueError (the run in .run); Ctrl-C raises RunInterrupted."""
-    if not callable(controller):
-        raise TypeError(f"controller must be callable f(t, y), not {type(controller).__name__}")
-    if isinstance(sample_time, bool) or not isinstance(sample_time, (int, float)):
-        raise TypeError(f"sample_time must be a number of seconds, not {type(sample_time).__name__}")
-    if isinstance(delay, bool) or not isinstance(delay, int):
-        raise TypeError(f"delay must be a whole number of samples, not {type(delay).__name__}")
-    run, error, bad = _rfem._run_controlled(_case(case), _n(n), _threads(threads), _os.fspath(output) if output else "",
-                                            bool(keep_series), _state(state), "rfem.run_controlled (Python)", controller,
-                                            float(sample_time), delay)
+    run, error, bad = _rfem._run_controlled(case, n, threads, output, keep_series, _state(state),
+                                            "rfem.run_controlled (Python)", controller, sample_time, delay)
     if error is not None:
         _raise_interrupt(error, run)
     if bad is not None:

@@ -261,3 +261,59 @@ def test_sweep_from_python_and_own_pool(tmp_path):
     with pytest.raises(rfem.CaseError) as e:
         rfem.load_sweep(sweep)
     assert code == 2 and str(e.value) == err.strip()[len("rfem: error: "):]
+
+
+NAN = float("nan")
+BAD_ARGUMENTS = [  # (call, exception, the message's start: the argument named, as the program names its options)
+    (lambda c: rfem.run("/no/such.toml"), rfem.CaseError, "/no/such.toml: "),
+    (lambda c: rfem.run(c, n=4.5), TypeError, "n: must be an integer"),
+    (lambda c: rfem.run(c, n=NAN), TypeError, "n: must be an integer"),
+    (lambda c: rfem.run(c, n=True), TypeError, "n: must be an integer"),
+    (lambda c: rfem.run(c, n=10**12), ValueError, "n: must be a positive integer up to 10000000"),
+    (lambda c: rfem.run(c, n=rfem.MAX_RFES + 1), ValueError, "n: must be a positive integer up to 10000000"),
+    (lambda c: rfem.run(c, n=0), ValueError, "n: "),
+    (lambda c: rfem.run(c, n=-1), ValueError, "n: "),
+    (lambda c: rfem.run(c, n=4, threads=-1), ValueError, "threads: "),
+    (lambda c: rfem.run(c, n=4, threads="2"), TypeError, "threads: "),
+    (lambda c: rfem.run(c, n=4, checkpoint=NAN), ValueError, "checkpoint: "),
+    (lambda c: rfem.run(c, n=4, checkpoint=-1.0), ValueError, "checkpoint: "),
+    (lambda c: rfem.run(c, n=4, runs=[1]), TypeError, "runs[0]: "),
+    (lambda c: rfem.run(c, n=4, output="a\0b.h5"), ValueError, "output: "),
+    (lambda c: rfem.run(c, n=4, progress=3), TypeError, "progress: "),
+    (lambda c: rfem.run(c, n=4, keep_series="yes"), TypeError, "keep_series: "),
+    (lambda c: rfem.run(resume=3), TypeError, "resume: "),
+    (lambda c: rfem.refine(c, ns=[4, 10**9], quantities=["forearm/peak:u1"]), ValueError, "ns[1]: "),
+    (lambda c: rfem.refine(c, ns=4, quantities=["forearm/peak:u1"]), TypeError, "ns: "),
+    (lambda c: rfem.modes(c, rate=NAN), ValueError, "rate: "),
+    (lambda c: rfem.modes(c, count=0), ValueError, "count: "),
+    (lambda c: rfem.modes(c, joint=1.0, rate=1.0), TypeError, "joint: "),
+    (lambda c: rfem.modes(c, free=[1.5]), TypeError, "free[0]: "),
+    (lambda c: rfem.static(c, rate="1"), TypeError, "rate: "),
+    (lambda c: rfem.show(c, n=0), ValueError, "n: "),
+    (lambda c: rfem.model(c, n=-1), ValueError, "n: "),
+    (lambda c: rfem.load("a\0b"), ValueError, "path: "),
+    (lambda c: rfem.load(3), TypeError, "path: "),
+    (lambda c: rfem.Case.from_text(3), TypeError, "text: "),
+    (lambda c: rfem.write_xdmf("a\0b.h5"), ValueError, "results: "),
+    (lambda c: rfem.run_point("s.toml", 0), TypeError, "sweep: "),
+    (lambda c: rfem.Simulation(c, n=0), ValueError, "n: "),
+    (lambda c: rfem.Simulation(c, n=4).advance(NAN), ValueError, "t: "),
+]
+
+
+@pytest.mark.parametrize("k", range(len(BAD_ARGUMENTS)))
+def test_bad_arguments_one_line(k):
+    """Every wrong argument is a TypeError (type) or ValueError (value; CaseError is one) with a line
+    naming it — never pybind11's overload dump, an overflow, a MemoryError, or accepted."""
+    call, error, start = BAD_ARGUMENTS[k]
+    case = rfem.load(case_path("two_link_arm.toml"), {"simulation.t_end": 0.1})
+    with pytest.raises(error) as e:
+        call(case)
+    message = str(e.value)
+    assert type(e.value) is error and "\n" not in message and message.startswith(start), message
+
+
+def test_run_status_from_the_library():
+    s = rfem.RunStatus.parse("interrupted (signal 2)")
+    assert (s.kind, s.signal, s.completed, str(s)) == ("interrupted", 2, False, "interrupted (signal 2)")
+    assert rfem.RunStatus.parse("completed").completed and rfem.RunStatus.parse("failed: why").reason == "why"
