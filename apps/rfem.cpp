@@ -208,6 +208,9 @@ int main(int argc, char** argv) {
   } catch (const rfem::CaseError& e) {
     fmt::print(stderr, "rfem: error: {}\n", e.what());
     return 2;
+  } catch (const rfem::ResultsError& e) {  // a results file that cannot be made or written: the caller's path
+    fmt::print(stderr, "rfem: error: {}\n", e.what());
+    return 2;
   } catch (const std::exception& e) {
     fmt::print(stderr, "rfem: error: {}\n", e.what());
     return 1;

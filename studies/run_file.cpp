@@ -17,12 +17,7 @@ FileRuns run_into_file(const Case& cs, RunRequest rq, const std::string& output,
   Parallelism p;
   p.threads = rq.threads;
   const FileDescription d = describe(cs, made_by, to_string(cs.sim.procedure), out.model->n(), p.max_threads(), rq.n);
-  std::unique_ptr<ResultsWriter> file;
-  try {
-    file = std::make_unique<ResultsWriter>(output, d);
-  } catch (const ResultsError& e) {  // the caller's path: bad input, not a failed run
-    throw CaseError(e.what());
-  }
+  auto file = std::make_unique<ResultsWriter>(output, d);  // (ResultsError for a path it cannot create)
   Hdf5Recorder recorder(*file);
   rq.observers.insert(rq.observers.begin(), &recorder);
   out.runs = run_case(cs, out.model, inputs, rq);

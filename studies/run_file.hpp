@@ -21,7 +21,7 @@ struct FileRuns {
 /// Runs the case's procedure into a new results file at `output`, in order: the case checked for
 /// a run (check_runnable), its model with rq.n rfes and its inputs (bad inputs fail here, before the
 /// file exists), the caller's `ready` (a cost check, a header line; it may throw to stop), the file
-/// created (a path that cannot be created is a CaseError), the runs recorded into it before rq's own
+/// created (ResultsError for a path that cannot be created), the runs recorded into it before rq's own
 /// observers see them, the file closed and ParaView's views written beside it (warnings through
 /// rq.warn). `made_by` is the command line or call kept in the file. Every row a run computed is in
 /// the file whatever its status.

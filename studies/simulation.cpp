@@ -210,12 +210,8 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
   if (!m.opts.output.empty()) {
     Parallelism p;
     p.threads = m.opts.threads;
-    try {
-      m.file = std::make_unique<ResultsWriter>(
-          m.opts.output, describe(cs, m.opts.made_by, "single", m.model->n(), p.max_threads(), m.opts.n));
-    } catch (const ResultsError& e) {  // the caller's path: bad input
-      throw CaseError(e.what());
-    }
+    m.file = std::make_unique<ResultsWriter>(  // (ResultsError for a path it cannot create)
+        m.opts.output, describe(cs, m.opts.made_by, "single", m.model->n(), p.max_threads(), m.opts.n));
     m.recorder = std::make_unique<Hdf5Recorder>(*m.file);
     m.rq.observers.push_back(m.recorder.get());
   }
@@ -364,7 +360,7 @@ Snapshot Simulation::snapshot() {
   y.joint_v = m.model->joint_coords(s.v);
   y.joint_tau = s.tau;
   for (size_t l = 0; l < m.model->links.size(); ++l) {
-    y.tip_position.push_back(tip_motion(*m.model, static_cast<int>(l), s.q).head<3>());
+    y.tip_position.push_back(tip_position(*m.model, static_cast<int>(l), s.q));
     y.tip_deflection.push_back(tip_deflection(*m.model, static_cast<int>(l), s.q));
   }
   return y;

@@ -67,8 +67,9 @@ struct Snapshot {
 
 class Simulation {
  public:
-  /// CaseError for a case that cannot run (studies/runs.hpp: check_runnable), BDF, a state of
-  /// another model; the results file, if any, is created here.
+  /// CaseError for a case that cannot run (studies/runs.hpp: check_runnable) or BDF;
+  /// std::invalid_argument for a state of another model; the results file, if any, is created here
+  /// (ResultsError for a path it cannot create).
   Simulation(const Case& cs, SimulationOptions opts);
   ~Simulation();  ///< finishes the run if the caller did not (status "interrupted (stopped)")
   Simulation(Simulation&&) noexcept;
