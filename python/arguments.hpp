@@ -33,7 +33,10 @@ inline std::string shown(py::handle v) { return py::repr(v).cast<std::string>();
 inline long integer(py::handle v, const std::string& name, long lo, long hi, const std::string& what) {
   if (PyBool_Check(v.ptr()) || !PyIndex_Check(v.ptr())) type_error(name, "an integer", v);
   const py::int_ i = py::reinterpret_steal<py::int_>(PyNumber_Index(v.ptr()));
-  if (!i) throw py::error_already_set();
+  if (!i) {  // (numpy arrays have __index__ but refuse it unless 0-d)
+    PyErr_Clear();
+    type_error(name, "an integer", v);
+  }
   int overflow = 0;
   const long long x = PyLong_AsLongLongAndOverflow(i.ptr(), &overflow);
   if (overflow != 0 || x < lo || x > hi) value_error(name, what, v);

@@ -23,6 +23,7 @@
 #include "rfem/studies/recorders.hpp"
 #include "rfem/studies/resume.hpp"
 #include "rfem/studies/refine.hpp"
+#include "rfem/studies/run_file.hpp"
 #include "rfem/studies/runs.hpp"
 #include "rfem/studies/show.hpp"
 #include "rfem/studies/static_study.hpp"
@@ -89,15 +90,20 @@ struct Pending {
   }
 };
 
-FileDescription python_description(const Case& cs, const std::string& call, const std::string& procedure, long n, long threads,
-                                   long n_option = -1) {
+// How a file was made from Python: the script's command line and the call.
+std::string python_made_by(const std::string& call) {
   std::string argv;
   try {
     py::gil_scoped_acquire gil;
     for (auto a : py::module_::import("sys").attr("argv")) argv += (argv.empty() ? "" : " ") + py::str(a).cast<std::string>();
   } catch (...) {
   }
-  return describe(cs, argv + (argv.empty() ? "" : " ") + "(Python " + call + ")", procedure, n, threads, n_option);
+  return argv + (argv.empty() ? "" : " ") + "(Python " + call + ")";
+}
+
+FileDescription python_description(const Case& cs, const std::string& call, const std::string& procedure, long n, long threads,
+                                   long n_option = -1) {
+  return describe(cs, python_made_by(call), procedure, n, threads, n_option);
 }
 
 py::dict stats_dict(const IntegratorStats& s) {
@@ -134,8 +140,7 @@ JointRate joint_rate(py::handle rate, py::handle joint) {
 // `free` of rfem.modes: joint names or numbers from 1 (as --free), one or a list.
 std::vector<std::string> free_joints(py::handle v) {
   std::vector<std::string> out;
-  auto one = [&](py::handle x) {
-    const std::string name = "free[" + std::to_string(out.size()) + "]";
+  auto one = [&](py::handle x, const std::string& name) {
     if (PyUnicode_Check(x.ptr()) || PyBool_Check(x.ptr()) || !PyIndex_Check(x.ptr())) {
       if (!PyUnicode_Check(x.ptr())) args::type_error(name, "a joint's name or number from 1", x);
       out.push_back(args::text(x, name));
@@ -144,12 +149,11 @@ std::vector<std::string> free_joints(py::handle v) {
     }
   };
   if (v.is_none()) return out;
-  if (PyUnicode_Check(v.ptr()) || PyIndex_Check(v.ptr())) {
-    one(v);
+  if (PyUnicode_Check(v.ptr()) || !py::isinstance<py::iterable>(v)) {
+    one(v, "free");
     return out;
   }
-  if (!py::isinstance<py::iterable>(v)) args::type_error("free", "a list of joint names or numbers from 1", v);
-  for (py::handle x : py::reinterpret_borrow<py::iterable>(v)) one(x);
+  for (py::handle x : py::reinterpret_borrow<py::iterable>(v)) one(x, "free[" + std::to_string(out.size()) + "]");
   return out;
 }
 
@@ -322,26 +326,10 @@ PYBIND11_MODULE(_rfem, m) {
     rq.runs = run_names(args::texts(runs, "runs"));
     std::vector<RunResult> results;
     {
+      const std::string made_by = output.empty() ? "" : python_made_by("rfem.run");
       py::gil_scoped_release release;
-      if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: missing table (t_end, output_dt, …) for a run");
-      if (cs.joints.empty()) throw CaseError(cs.path + ": joints: a run needs at least one base joint");
-      const auto model = model_of(cs, n);
-      const std::vector<JointInput> inputs = joint_inputs(cs, rq.warn);
-      std::unique_ptr<ResultsWriter> file;
-      std::unique_ptr<Hdf5Recorder> recorder;
-      if (!output.empty()) {
-        Parallelism p;
-        p.threads = rq.threads;
-        file = std::make_unique<ResultsWriter>(
-            output, python_description(cs, "rfem.run", to_string(cs.sim.procedure), model->n(), p.max_threads(), n));
-        recorder = std::make_unique<Hdf5Recorder>(*file);
-        rq.observers.push_back(recorder.get());
-      }
-      results = run_case(cs, model, inputs, rq);
-      if (file) {
-        file->close();
-        write_views(cs, *model, output, rq.warn);
-      }
+      // Into a file: the one path the program takes (studies/run_file.hpp); else in memory only.
+      results = output.empty() ? run_case(cs, rq) : run_into_file(cs, rq, output, made_by).runs;
     }
     py::list out;
     for (auto& r : results) out.append(std::make_shared<RunResult>(std::move(r)));

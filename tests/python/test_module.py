@@ -253,6 +253,10 @@ def test_sweep_from_python_and_own_pool(tmp_path):
     assert np.array_equal(r["table"], h5py.File(tmp_path / "cli.h5")["quantities"][()])
     s = rfem.load_sweep(sweep, output=tmp_path / "own.h5")
     rows = [rfem.run_point(s, k) for k in range(len(s))]
+    with pytest.raises(ValueError, match=r"^k: must be a point of the sweep, 0 to 3 \(got 4\)$"):
+        rfem.run_point(s, 4)
+    with pytest.raises(TypeError, match=r'^rows\[1\]\["values"\]: must be a list of numbers'):
+        rfem.write_index(s, rows[:1] + [dict(rows[1], values="x")] + rows[2:])
     rfem.write_index(s, rows)
     assert np.array_equal(h5py.File(tmp_path / "own.h5")["quantities"][()], r["table"])
     assert rfem.finished_point(s, 0)["status"] == "completed"
