@@ -192,6 +192,9 @@ Case parse_case(const std::string& text, const std::string& path, const std::vec
   const Sections secs = read_sections(r, root);
   std::vector<ParentRef> joint_parents, link_parents;
   read_links(r, root, mats, secs, c, link_parents);
+  if (const toml::node *jn = root.get("joints"), *bn = root.get("base");
+      jn && !jn->is_array() && bn && bn->is_table() && bn->as_table()->get("urdf"))
+    refuse_joints_table(r, *jn, *bn->as_table(), case_dir);  // a URDF joint's setting meant
   read_joints(r, root, mats, secs, case_dir, c, joint_parents);
   if (const toml::node* bn = root.get("base")) read_base(r, bn, mats, secs, path, case_dir, c, joint_parents);
   resolve_parents(r, c, joint_parents, link_parents);

@@ -39,6 +39,7 @@ struct InputSpec {
   std::shared_ptr<InputSpec> reference;
   double kp = 0, kd = 0;
   Feedforward feedforward = Feedforward::None;
+  bool none_given = false;  ///< a URDF joint the case gives no input: free, under zero torque
   bool prescribed() const { return is_motion(kind); }
 };
 

@@ -54,6 +54,15 @@ class Reader {
     os << ": " << key << ": " << what;
     warnings_.push_back(os.str());
   }
+  /// A value far outside what it can physically be (a unit slip, most often): refused naming file,
+  /// line and key, unless the case acknowledges that key ([case] accept), which then keeps it silently.
+  void doubt(const toml::node* node, const std::string& key, const std::string& what) const {
+    if (accepted_.count(key)) {
+      used_.insert(key);
+      return;
+    }
+    fail(node, key, what + "; if it is meant, acknowledge it: [case] accept = [\"" + key + "\"]");
+  }
   const std::vector<std::string>& warnings() const { return warnings_; }
   /// Keys whose warnings the case acknowledges ([case] accept = ["sections.B2.J"]).
   void accept(const std::string& key) { accepted_.insert(key); }
@@ -207,6 +216,17 @@ class Reader {
 };
 
 
+/// What real materials span, defined once for the plausibility checks of [materials]: from the
+/// softest solid a link is made of, a soft elastomer (E ~ 1e5 Pa, G ~ E/3 at nu = 0.5), to diamond
+/// (E 1.2e12 Pa, G 5e11 Pa); from the lightest structural foams (10 kg/m^3) to osmium (2.26e4
+/// kg/m^3). Beyond them a value is a unit slip (GPa or MPa for Pa, g/cm^3 for kg/m^3) far more
+/// often than a material: refused unless the case acknowledges it (Reader::doubt).
+struct MaterialRange {
+  double lo, hi;
+  bool holds(double v) const { return v >= lo && v <= hi; }
+};
+inline constexpr MaterialRange kPlausibleE{1e5, 1.2e12}, kPlausibleG{3e4, 6e11}, kPlausibleRho{10.0, 2.3e4};
+
 using Materials = std::map<std::string, Material>;
 using Sections = std::map<std::string, Section>;
 
@@ -239,6 +259,9 @@ void read_joints(const Reader& r, const toml::table& root, const Materials& mats
 /// [base] urdf = "…": the URDF's movable joints ahead of the case's, its links in c.frames.
 void read_urdf_base(const Reader& r, const toml::table& bt, const std::string& case_dir, Case& c,
                     std::vector<ParentRef>& parents);
+/// `joints` given as a table in a case with a URDF base (`--set joints.1.input.kp=…`): refused,
+/// pointing to base.joints.NAME.
+[[noreturn]] void refuse_joints_table(const Reader& r, const toml::node& jn, const toml::table& bt, const std::string& case_dir);
 /// A joint's input table (joints.i.input, base.joints.NAME.input).
 InputSpec read_input(const Reader& r, const toml::table& t, const std::string& path, const std::string& case_dir);
 /// [base] kind = "free": six joints ahead of the case's (with parents that need no names).

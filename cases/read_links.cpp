@@ -57,9 +57,15 @@ LinkCase read_link(const Reader& r, const toml::table& lt, const std::string& ke
       pl.at = std::min(pl.at, L);
       pl.H = read_body(r, pt, p, mats, secs, {"at"});
       if (pl.H(3, 3) <= 0.0) r.fail(&pt, p + ".mass", "a payload needs a positive mass");
+      // A payload far heavier than its link was likely given in grams; but where a density is
+      // itself implausible (accepted), the link's mass says nothing about the payload's unit.
       double link_mass = 0.0;
-      for (const Segment& s : c.link.segments) link_mass += s.material.rho * s.section.A * s.length;
-      if (pl.H(3, 3) > 100 * link_mass)
+      bool plausible = true;
+      for (const Segment& s : c.link.segments) {
+        link_mass += s.material.rho * s.section.A * s.length;
+        plausible = plausible && kPlausibleRho.holds(s.material.rho);
+      }
+      if (plausible && pl.H(3, 3) > 100 * link_mass)
         r.warn(pt.get("mass") ? pt.get("mass") : &pt, p + ".mass",
                "a payload of " + Reader::fmt(pl.H(3, 3)) + " kg is " + Reader::fmt(std::round(pl.H(3, 3) / link_mass)) +
                    " times the link's mass (" + Reader::fmt(link_mass) + " kg): units are kg (if grams were meant, write " +
@@ -117,7 +123,19 @@ void resolve_parents(const Reader& r, Case& c, const std::vector<ParentRef>& joi
   };
   for (int j = 0; j < m; ++j) add(c.joints[j].name, {Mounting::Kind::Joint, j}, joint_parents[j]);
   for (int l = 0; l < nl; ++l) add(c.links[l].name, {Mounting::Kind::Link, l}, link_parents[l]);
-  auto mounting = [&](const ParentRef& pr, bool joint) {
+  // What `self` may sit on, by kind: "joints a, b; links c; URDF links d, e; or \"ground\"".
+  auto choices = [&](const Entity& self) {
+    std::string js, ls, us;
+    for (const auto& [k, e] : named)
+      if (!(e.kind == self.kind && e.index == self.index)) (e.kind == Mounting::Kind::Joint ? js : ls) += (", " + k);
+    for (const BodyFrame& b : c.frames) us += ", " + b.name;
+    std::string out;
+    for (const auto& [what, list] : {std::pair{"joints ", js}, {"links ", ls}, {"URDF links ", us}})
+      if (!list.empty()) out += what + list.substr(2) + "; ";
+    return out + "or \"ground\"";
+  };
+  auto mounting = [&](const ParentRef& pr, bool joint, int index) {
+    const Entity self{joint ? Mounting::Kind::Joint : Mounting::Kind::Link, index};
     Mounting on;
     on.X = pr.X;
     if (pr.name.empty()) {
@@ -137,10 +155,11 @@ void resolve_parents(const Reader& r, Case& c, const std::vector<ParentRef>& joi
         on.index = f->joint;
         on.X = f->X * pr.X;
       } else if (it == named.end()) {
-        std::string list;
-        for (const auto& [k, e] : named) list += (list.empty() ? "" : ", ") + k;
-        for (const BodyFrame& b : c.frames) list += ", " + b.name;
-        r.fail(pr.node, pr.path + ".parent", "no joint or link named '" + pr.name + "' (" + list + ", or \"ground\")");
+        r.fail(pr.node, pr.path + ".parent", "no joint or link named '" + pr.name + "' (" + choices(self) + ")");
+      } else if (it->second.kind == self.kind && it->second.index == self.index) {
+        // (often a URDF link misnamed as the [link]'s own default name "link")
+        r.fail(pr.node, pr.path + ".parent", "'" + pr.name + "' is " + (joint ? "this joint" : "this link") +
+                                                 " itself: no other joint or link has that name (" + choices(self) + ")");
       } else {
         on.kind = it->second.kind;
         on.index = it->second.index;
@@ -162,8 +181,8 @@ void resolve_parents(const Reader& r, Case& c, const std::vector<ParentRef>& joi
     }
     return on;
   };
-  for (int j = 0; j < m; ++j) c.joints[j].on = mounting(joint_parents[j], true);
-  for (int l = 0; l < nl; ++l) c.links[l].on = mounting(link_parents[l], false);
+  for (int j = 0; j < m; ++j) c.joints[j].on = mounting(joint_parents[j], true, j);
+  for (int l = 0; l < nl; ++l) c.links[l].on = mounting(link_parents[l], false, l);
   // The defaults (a link on the last joint of the chain from the ground), the points and the
   // cycles: the model's rule (core/mounting.hpp), reported at the parent key of whom it concerns.
   std::vector<Mounting> jon, lon;
@@ -179,6 +198,31 @@ void resolve_parents(const Reader& r, Case& c, const std::vector<ParentRef>& joi
   }
   for (int j = 0; j < m; ++j) c.joints[j].on = jon[j];
   for (int l = 0; l < nl; ++l) c.links[l].on = lon[l];
+  // A joint under a force input that moves no mass (no body, no drive inertia, nothing mounted on
+  // it that has one) has no acceleration the equations of motion can give: its mass matrix row is
+  // zero. Refused here, by name, rather than as a singular mass matrix at the first step.
+  std::vector<char> moves(m, 0);  // whether joint j moves some mass or inertia
+  for (int l = 0; l < nl; ++l)
+    if (c.links[l].on.kind == Mounting::Kind::Joint) moves[c.links[l].on.index] = 1;
+  for (bool changed = true; changed;) {  // up the tree (no cycles: resolve_mountings)
+    changed = false;
+    for (int j = 0; j < m; ++j) {
+      const Joint& J = c.joints[j];
+      const bool own = J.H.cwiseAbs().maxCoeff() > 0.0 || J.drive.inertia > 0.0;
+      if ((own || moves[j]) && J.on.kind == Mounting::Kind::Joint && !moves[J.on.index]) moves[J.on.index] = 1, changed = true;
+      if (own && !moves[j]) moves[j] = 1, changed = true;
+    }
+  }
+  for (int j = 0; j < m; ++j) {
+    if (moves[j] || (j < static_cast<int>(c.inputs.size()) && c.inputs[j].prescribed())) continue;
+    const ParentRef& pr = joint_parents[j];
+    const bool urdf = pr.path == "base.urdf";
+    r.fail(pr.node, urdf ? "base.joints." + c.joints[j].name : pr.path,
+           "joint '" + c.joints[j].name + "' moves no mass: it has no " + (urdf ? "inertial in the URDF" : "body") +
+               ", no drive inertia, and nothing with mass is mounted on it, so under its force input (" +
+               to_string(c.inputs[j].kind) + ") its acceleration is undetermined; give it a body or drive.inertia, "
+               "mount something on it, or give it a motion input");
+  }
   // A joint left without a parent sits on the previous joint; where a link sits there too, the
   // joint was often meant to sit on that link (an elbow on the upper arm's tip): say so.
   for (int j = 1; j < m; ++j) {

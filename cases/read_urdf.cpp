@@ -158,6 +158,7 @@ void read_urdf_base(const Reader& r, const toml::table& bt, const std::string& c
   std::vector<ParentRef> refs;
   std::vector<double> values, rates;
   std::vector<InputSpec> inputs;
+  std::vector<std::string> free_joints;  // given no input
   struct Where {
     int joint = -1;  // the body it is welded to: a joint's, −1 the ground
     Mat4 X = Mat4::Identity();
@@ -247,6 +248,10 @@ void read_urdf_base(const Reader& r, const toml::table& bt, const std::string& c
           r.warn(t.get("value"), p + ".value", "lies outside the joint's limits in " + given + ", " + Reader::fmt(uj->limits->lower) +
                                                    " to " + Reader::fmt(uj->limits->upper));
       }
+      if (!given_joints || !given_joints->get(j.name) || !given_joints->get(j.name)->as_table()->get("input")) {
+        input.none_given = true;
+        free_joints.push_back(j.name);
+      }
       ParentRef pr;
       pr.path = "base.urdf";
       pr.node = un;
@@ -264,6 +269,15 @@ void read_urdf_base(const Reader& r, const toml::table& bt, const std::string& c
   at[model->getRoot()->name] = {};
   walk(model->getRoot());
   if (joints.empty()) fail("no movable joint (revolute, continuous or prismatic)");
+  if (!free_joints.empty()) {  // the URDF brings joints the case may not have thought of: say what they do
+    std::string list;
+    for (const std::string& n : free_joints) list += (list.empty() ? "'" : ", '") + n + "'";
+    const bool one = free_joints.size() == 1;
+    r.warn(given_joints ? bt.get("joints") : un, "base.joints",
+           "URDF joint" + std::string(one ? " " : "s ") + list + (one ? " has" : " have") +
+               " no input: free, under zero torque (write [base.joints." + free_joints[0] +
+               "] input = { kind = \"torque\", value = 0.0 } to keep " + (one ? "it" : "each") + " so, or another input)");
+  }
 
   // The URDF's joints ahead of the case's [[joints]] (those may sit on URDF links by name).
   const long m0 = c.joint_values.size(), mu = static_cast<long>(joints.size());
@@ -276,6 +290,30 @@ void read_urdf_base(const Reader& r, const toml::table& bt, const std::string& c
   c.inputs.insert(c.inputs.begin(), inputs.begin(), inputs.end());
   parents.insert(parents.begin(), refs.begin(), refs.end());
   for (const auto& [name, where] : at) c.frames.push_back({name, where.joint, where.X});
+}
+
+void refuse_joints_table(const Reader& r, const toml::node& jn, const toml::table& bt, const std::string& case_dir) {
+  Case scratch;  // the URDF's joints, in the case's order (its warnings do not matter: this fails)
+  std::vector<ParentRef> parents;
+  read_urdf_base(r, bt, case_dir, scratch, parents);
+  std::string names, hint;
+  for (const Joint& j : scratch.joints) names += (names.empty() ? "" : ", ") + j.name;
+  // The first path given below `joints` (joints.1.input.kp): the same setting of that URDF joint.
+  std::string rest;
+  const toml::node* n = &jn;
+  std::string first;
+  for (bool top = true; n && n->is_table() && !n->as_table()->empty(); top = false) {
+    const auto it = n->as_table()->begin();  // (its pair lives in the iterator)
+    (top ? first : rest) += (top || rest.empty() ? "" : ".") + std::string(it->first.str());
+    n = &it->second;
+  }
+  char* end = nullptr;
+  const long i = first.empty() ? -1 : std::strtol(first.c_str(), &end, 10);
+  if (end && *end == '\0' && i >= 0 && i < static_cast<long>(scratch.joints.size()))
+    hint = " (joints." + first + (rest.empty() ? "" : "." + rest) + " is base.joints." + scratch.joints[i].name +
+           (rest.empty() ? "" : "." + rest) + ")";
+  r.fail(&jn, "joints", "this case's joints come from its URDF (" + names + "): each one's value, rate, input and drive are in " +
+                            "[base.joints.NAME]" + hint + "; [[joints]] adds joints of the case's own");
 }
 
 }  // namespace rfem::reading

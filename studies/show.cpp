@@ -10,6 +10,7 @@ namespace rfem {
 namespace {
 
 std::string input_text(const InputSpec& in) {
+  if (in.none_given) return "none given: free, under zero torque (force input)";
   std::string s = to_string(in.kind);
   if (in.kind == InputKind::Pd && in.reference)
     s += " on " + to_string(in.reference->kind) + (in.feedforward == Feedforward::Rigid ? " + rigid computed torque" : "");

@@ -87,10 +87,13 @@ import h5py, sys
 tau = h5py.File('bom.h5')['run/joint_tau'][:, 0]
 sys.exit(0 if abs(tau[0] - 100) < 1e-12 and abs(tau[5] - 95) < 1e-9 else 1)" && ok "table behind a BOM: torque 100 at t = 0, 95 at 0.05 s" || bad "BOM table: $(cat err.txt)"
 
-# 3. A run that fails at its start records why (once: exit 1 with status "running", no t_reached).
+# 3. A run that fails at its start records why (once: exit 1 with status "running", no t_reached):
+#    a point mass on its joint's axis (no inertia about it; a joint with no mass at all is refused
+#    at reading).
 cat > massless.toml <<'EOF'
 [[joints]]
 name = "free"
+body = { mass = 1.0 }
 input = { kind = "torque", value = 1.0 }
 [simulation]
 t_end = 0.1

@@ -33,10 +33,25 @@ warns "sections.kane.A: A = 40 m^2 is a cross-section over a metre across" "A = 
 warns "sections.kane.A: A = 0.004 m^2 with Iy + Iz = 4e-07 m^4 is no real section" "A ten times too large for its Iy, Iz"
 "$rfem" show "$src/cases/two_link_arm.toml" --set links.1.payloads.0.mass=200 > /dev/null 2> w.txt
 warns "links.1.payloads.0.mass: a payload of 200 kg is 463 times the link's mass" "a payload of 200"
-"$rfem" static "$src/cases/kane_beam.toml" --set materials.kane.E=7e13 --set materials.kane.G=2.6e13 > /dev/null 2> w.txt
-warns "materials.kane.E: E = 7e+13 Pa is stiffer than diamond" "E = 7e13"
-"$rfem" static "$src/cases/kane_beam.toml" --set materials.kane.rho=2.7e5 > /dev/null 2> w.txt
-warns "materials.kane.rho: rho = 270000 kg/m^3 is denser than any material" "rho = 2.7e5"
+refused() {  # pattern what: the last command (exit code $code) stopped with one line matching pattern
+  [ $code = 2 ] && [ "$(wc -l < w.txt)" = 1 ] && grep -q "^rfem: error: .*$1" w.txt && ok "$2: $(cut -c1-160 w.txt)" \
+    || bad "$2: exit $code $(cat w.txt)"
+}
+#    A material value beyond any material (once: E = 70 Pa only warned, blaming G, and the run went
+#    on to 15 rad) stops the reading unless the case acknowledges it with [case] accept.
+"$rfem" static "$src/cases/kane_beam.toml" --set materials.kane.E=7e13 --set materials.kane.G=2.6e11 > /dev/null 2> w.txt; code=$?
+refused "materials.kane.E: E = 7e+13 Pa is stiffer than diamond .*accept = \[\"materials.kane.E\"\]" "E = 7e13"
+"$rfem" static "$src/cases/kane_beam.toml" --set materials.kane.rho=2.7e5 > /dev/null 2> w.txt; code=$?
+refused "materials.kane.rho: rho = 270000 kg/m^3 is denser than any material" "rho = 2.7e5"
+"$rfem" run "$src/cases/two_link_arm.toml" --set materials.al.E=70 -q -o e70.h5 > /dev/null 2> w.txt; code=$?
+refused "materials.al.E: E = 70 Pa is very small" "E = 70 (Pa for GPa), G sound"
+[ ! -e e70.h5 ] && ok "E = 70: nothing run" || bad "E = 70 ran"
+"$rfem" show "$src/cases/two_link_arm.toml" --set materials.al.E=70 --set 'case.accept=["materials.al.E"]' > /dev/null 2> w.txt
+[ $? = 0 ] && [ ! -s w.txt ] && ok "E = 70 acknowledged: read, and G not blamed" || bad "E = 70 accepted: $(cat w.txt)"
+"$rfem" show "$src/cases/two_link_arm.toml" --set materials.al.rho=2.7 > /dev/null 2> w.txt; code=$?
+refused "materials.al.rho: rho = 2.7 kg/m^3 is very small" "rho = 2.7 (g/cm^3)"
+"$rfem" show "$src/cases/two_link_arm.toml" --set materials.al.rho=2.7 --set 'case.accept=["materials.al.rho"]' > /dev/null 2> w.txt
+[ $? = 0 ] && [ ! -s w.txt ] && ok "rho = 2.7 acknowledged: the 0.1 kg payload not taken for grams" || bad "rho = 2.7: $(cat w.txt)"
 for v in 1e300 1e-300; do
   "$rfem" modes "$src/cases/kane_beam.toml" --set materials.kane.E=$v > out.txt 2> err.txt; code=$?
   [ $code = 2 ] && grep -q "materials.kane.E: must lie within what rfem computes with" err.txt \
@@ -57,6 +72,21 @@ import json, sys
 e = {x['name']: x for x in json.load(open('tree.json'))['entries']}
 sys.exit(0 if e['wrist']['parent'] == 'beam' and e['beam.payload1']['where'] == 'at 5 m' and e['hub']['depth'] == 0 else 1)" \
   && ok "show --json: wrist on the beam, payload at 5 m" || bad "show --json"
+
+#    A URDF base: a joint the case gives no input is free under zero torque, said once at reading
+#    and in the tree (once: silently); a misnamed parent lists the URDF's links (once: "the
+#    mountings form a cycle"); a [[joints]] path on URDF joints points to base.joints.NAME.
+sed -e '/^\[base.joints.elbow\]/,/^$/d' -e 's#"urdf/#"'"$src"'/cases/urdf/#' "$src/cases/urdf_arm.toml" > noelbow.toml
+"$rfem" show noelbow.toml > tree.txt 2> w.txt
+warns "base.joints: URDF joint 'elbow' has no input: free, under zero torque" "a URDF joint without an input"
+[ "$(grep -c . w.txt)" = 1 ] && grep -q "joint elbow — on shoulder: revolute about y; input none given: free, under zero torque" tree.txt \
+  && ok "show: the elbow free, said once" || bad "show, free elbow: $(cat w.txt tree.txt)"
+"$rfem" show "$src/cases/urdf_arm.toml" --set link.name=link --set link.parent=link > /dev/null 2> w.txt; code=$?
+refused "link.parent: 'link' is this link itself: no other joint or link has that name (joints elbow, shoulder, waist; URDF links base_link, forearm, tool0, turret, upper_arm; or \"ground\")" \
+  "a URDF link misnamed as the link itself"
+"$rfem" run "$src/cases/urdf_arm.toml" --set joints.1.input.kp=5 > /dev/null 2> w.txt; code=$?
+refused "joints: this case's joints come from its URDF (waist, shoulder, elbow): .*(joints.1.input.kp is base.joints.shoulder.input.kp)" \
+  "joints.1.input.kp on URDF joints"
 
 # 4. Refinement of what the paper plots: the torque the flexibility adds (Fig. 6's point), its RMS
 #    over the motion, the force run's rate; only the runs the quantities read are run.

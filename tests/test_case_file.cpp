@@ -88,3 +88,36 @@ TEST(CaseFile, BadInputNamesFileLineAndKey) {
   EXPECT_NE(error_of(kGood, {"link.nope.x=1"}).find("link.nope: unknown key"), std::string::npos);
   EXPECT_NE(error_of(kGood, {"link.n"}).find("expected key.path=value"), std::string::npos);
 }
+
+TEST(CaseFile, ValuesBeyondAnyMaterialStopUnlessAcknowledged) {
+  // E = 70 (GPa meant): refused, blaming E (it once warned of G > E/2 first and ran on); accepted,
+  // it is kept without a word on G.
+  const std::string e70 = replace(kGood, "E = 7e10", "E = 70");
+  EXPECT_NE(error_of(e70).find("bad.toml:2: materials.al.E: E = 70 Pa is very small"), std::string::npos) << error_of(e70);
+  EXPECT_NE(error_of(e70).find("accept = [\"materials.al.E\"]"), std::string::npos);
+  const Case c = parse_case("[case]\naccept = [\"materials.al.E\"]\n" + e70);
+  EXPECT_DOUBLE_EQ(c.links[0].link.segments[0].material.E, 70.0);
+  EXPECT_TRUE(c.warnings.empty()) << c.warnings[0];
+  EXPECT_NE(error_of(replace(kGood, "rho = 2700", "rho = 2.7")).find("materials.al.rho: rho = 2.7 kg/m^3 is very small"), std::string::npos);
+  EXPECT_NE(error_of(replace(kGood, "G = 2.7e10", "G = 2.7e12")).find("materials.al.G: G = 2.7e+12 Pa is stiffer than diamond"), std::string::npos);
+  // A 0.5 kg payload on a 2 m aluminium link (2.16 kg) is no slip; with rho = 2.7 (g/cm^3 meant,
+  // acknowledged) the link weighs 2 g, and the payload is still not taken for grams.
+  const std::string payload = std::string(kGood) + "\n[[link.payloads]]\nat = \"tip\"\nmass = 0.5\n";
+  EXPECT_TRUE(parse_case(payload).warnings.empty());
+  const Case light = parse_case("[case]\naccept = [\"materials.al.rho\"]\n" + replace(payload, "rho = 2700", "rho = 2.7"));
+  EXPECT_TRUE(light.warnings.empty()) << light.warnings[0];
+}
+
+TEST(CaseFile, AJointThatMovesNoMassIsNamed) {
+  // A joint at the end of the chain with no body under a torque: its mass matrix row is zero (once
+  // "the mass matrix is not positive definite" at the first step, naming no joint).
+  const std::string hub = std::string(kGood) + "\n[[joints]]\nname = \"hub\"\nbody = { mass = 1.0 }\n";
+  const std::string wrist = hub + "\n[[joints]]\nname = \"wrist\"\nparent = \"link\"\n";
+  EXPECT_NE(error_of(wrist).find("joints.1: joint 'wrist' moves no mass: it has no body, no drive inertia"), std::string::npos)
+      << error_of(wrist);
+  // With a rotor inertia, a motion input, or a link mounted on it, it is fine.
+  EXPECT_NO_THROW(parse_case(wrist + "drive = { inertia = 1e-4 }\n"));
+  EXPECT_NO_THROW(parse_case(wrist + "input = { kind = \"constant_rate\", rate = 1.0 }\n"));
+  // A joint with no body that carries a link (the link's default parent: the last joint).
+  EXPECT_NO_THROW(parse_case(std::string(kGood) + "\n[[joints]]\nname = \"hub\"\n"));
+}

@@ -13,6 +13,7 @@
 
 #include "rfem/studies/modes_study.hpp"
 #include "rfem/studies/runs.hpp"
+#include "rfem/studies/show.hpp"
 #include "rfem/studies/static_study.hpp"
 #include "tests/test_models.hpp"
 
@@ -129,4 +130,72 @@ TEST(Urdf, RunsWarnWhereTheJointsLeaveTheirRatedLimits) {
   EXPECT_NE(w[0].find("joint 'shoulder': its rate exceeded its rated 0.3 rad/s by up to 0.2"), std::string::npos) << w[0];
   EXPECT_NE(w[1].find("joint 'shoulder': its torque exceeded its rated 5 N m by up to 2"), std::string::npos) << w[1];
   std::filesystem::remove(path);
+}
+
+namespace {
+// The shipped arm's URDF with `from` replaced by `to`, in a temporary file; the error of reading
+// the arm's case on it ("no error" if none).
+std::string error_with(const std::string& from, const std::string& to) {
+  std::ifstream in(test::source_path("cases/urdf/three_link_arm.urdf"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string urdf = text.str();
+  if (urdf.find(from) == std::string::npos) return "'" + from + "' not in the URDF";
+  urdf.replace(urdf.find(from), from.size(), to);
+  const std::string path = (std::filesystem::temp_directory_path() / "rfem_test_changed_arm.urdf").string();
+  std::ofstream(path) << urdf;
+  std::string what = "no error";
+  try {
+    read_case(test::source_path("cases/urdf_arm.toml"), {"base.urdf=\"" + path + "\""});
+  } catch (const CaseError& e) {
+    what = e.what();
+  }
+  std::filesystem::remove(path);
+  return what;
+}
+}  // namespace
+
+TEST(Urdf, EveryNumberIsANumber) {
+  // urdfdom reads "three" as 0 kg, "3.0 4.0" as 3 kg and takes NaN: each is refused, naming the
+  // file, line, link or joint and attribute.
+  const std::string mass = R"(<mass value="3.0"/>)";
+  std::string e = error_with(mass, R"(<mass value="three"/>)");
+  EXPECT_NE(e.find("rfem_test_changed_arm.urdf:40: link 'upper_arm': <mass value=\"three\">: must be a finite number"), std::string::npos) << e;
+  e = error_with(mass, R"(<mass value="3.0 4.0"/>)");
+  EXPECT_NE(e.find("link 'upper_arm': <mass value=\"3.0 4.0\">: must be a finite number"), std::string::npos) << e;
+  e = error_with(R"(ixx="0.03")", R"(ixx="nan")");
+  EXPECT_NE(e.find("link 'turret': <inertia ixx=\"nan\">: must be a finite number"), std::string::npos) << e;
+  e = error_with(R"(<axis xyz="0 0 1"/>)", R"(<axis xyz="0 0 1 0"/>)");
+  EXPECT_NE(e.find("joint 'waist': <axis xyz=\"0 0 1 0\">: must be 3 finite numbers"), std::string::npos) << e;
+  e = error_with(R"(lower="-2.0")", R"(lower="-2,0")");
+  EXPECT_NE(e.find("joint 'shoulder': <limit lower=\"-2,0\">: must be a finite number"), std::string::npos) << e;
+  e = error_with(R"(damping="0.5")", R"(damping="inf")");
+  EXPECT_NE(e.find("joint 'waist': <dynamics damping=\"inf\">: must be a finite number"), std::string::npos) << e;
+  EXPECT_EQ(error_with(R"(<origin xyz="0 0 0.3" rpy="0 0 0"/>)", R"(<origin xyz=" +0 0  3e-1 " rpy="0 0 0"/>)"), "no error");
+}
+
+TEST(Urdf, ALinkWithTwoParentJointsIsRefused) {
+  // urdfdom kept one of them and dropped the other without a word.
+  const std::string e = error_with("</robot>", R"(<joint name="extra" type="fixed"><parent link="base_link"/><child link="forearm"/></joint></robot>)");
+  EXPECT_NE(e.find("link 'forearm' has two parent joints, 'elbow' and 'extra'"), std::string::npos) << e;
+}
+
+TEST(Urdf, AJointGivenNoInputIsSaidToBeFree) {
+  // Once at reading, for every such joint together, and on the joint's line of `rfem show`.
+  EXPECT_TRUE(urdf_arm().warnings.empty());
+  std::ifstream in(test::source_path("cases/urdf_arm.toml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string toml = text.str();
+  const size_t from = toml.find("[base.joints.shoulder]"), to = toml.find("[materials.");
+  ASSERT_LT(from, to);
+  toml.erase(from, to - from);  // the shoulder's and the elbow's tables
+  const Case c = parse_case(toml, "arm.toml", kShort, test::source_path("cases/"));
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_NE(c.warnings[0].find("base.joints: URDF joints 'shoulder', 'elbow' have no input: free, under zero torque"),
+            std::string::npos) << c.warnings[0];
+  EXPECT_FALSE(c.inputs[0].none_given);
+  EXPECT_TRUE(c.inputs[1].none_given && c.inputs[2].none_given);
+  const std::string tree = format_summary(show_model(c));
+  EXPECT_NE(tree.find("joint elbow — on shoulder: revolute about y; input none given: free, under zero torque"), std::string::npos) << tree;
 }
