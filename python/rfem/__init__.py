@@ -120,9 +120,13 @@ def _raise(error, result):
 
 
 def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, progress=None, resume=None,
-        checkpoint=_rfem.CHECKPOINT_INTERVAL):
+        checkpoint=_rfem.CHECKPOINT_INTERVAL, controller=None, sample_time=None, delay=0):
     """Runs the case's [simulation] by its procedure (single: "run"; paper: "rigid", "kinematic",
     "force") and returns the Runs.
+
+    controller:  f(t, y) in the loop at t = k * sample_time [s], its outputs held (zero-order hold)
+                 `delay` samples later: rfem.run_controlled (one run, "run"; no runs, progress, resume
+                 or checkpoint with it)
 
     n:           rfes in all links (None: the case's own)
     output:      an HDF5 results file written while the runs go (the layout of `rfem run`), and
@@ -151,6 +155,14 @@ def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, 
         return result
     if case is None:
         raise ValueError("rfem.run needs a case (or resume=RESULTS.h5)")
+    if controller is not None or sample_time is not None:
+        if controller is None or sample_time is None:
+            raise ValueError("rfem.run: a controller needs its sample_time, and a sample_time a controller")
+        if runs is not None or progress is not None:
+            raise ValueError("rfem.run(controller=...) is one run: no runs or progress with it")
+        result = Runs([run_controlled(case, controller, sample_time, n=n, delay=delay, output=output, threads=threads,
+                                      keep_series=keep_series)])
+        return result
     out, error, warnings = _rfem._run(case, n, output, runs, threads, keep_series, progress, checkpoint)
     result = Runs(out)
     result.warnings = warnings

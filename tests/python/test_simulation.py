@@ -130,3 +130,16 @@ def test_ctrl_c_in_a_controller_is_an_interruption(tmp_path):
     assert e.value.result.status.startswith("interrupted")
     with h5py.File(tmp_path / "i.h5") as h:
         assert h["run/time"].shape[0] >= 11
+
+
+def test_run_takes_a_controller():
+    case = hub(t_end=0.1)
+
+    def f(t, y):
+        return {"hub": 200.0}
+
+    a = rfem.run(case, controller=f, sample_time=1e-2, threads=1)["run"]
+    b = rfem.run_controlled(case, f, 1e-2, threads=1)
+    assert np.array_equal(a.table("joint_q"), b.table("joint_q"))
+    with pytest.raises(ValueError, match="sample_time"):
+        rfem.run(case, controller=f)
