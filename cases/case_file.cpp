@@ -170,7 +170,7 @@ Case parse_case(const std::string& text, const std::string& path, const std::vec
     c.effective_text = os.str();
   }
   Reader r(path);
-  r.check_keys(root, "", {"case", "materials", "sections", "link", "links", "joints", "gravity", "loads", "simulation", "base"});
+  r.check_keys(root, "", {"case", "materials", "sections", "link", "links", "joints", "gravity", "loads", "simulation", "base", "sensors"});
   const std::string& case_dir = c.base_dir;
 
   if (const toml::node* n = root.get("case")) {
@@ -198,6 +198,7 @@ Case parse_case(const std::string& text, const std::string& path, const std::vec
   read_joints(r, root, mats, secs, case_dir, c, joint_parents);
   if (const toml::node* bn = root.get("base")) read_base(r, bn, mats, secs, path, case_dir, c, joint_parents);
   resolve_parents(r, c, joint_parents, link_parents);
+  c.sensors = read_sensors(r, root, c);
   if (!c.has_link() && c.joints.empty()) r.fail(&root, "link", "a case needs a flexible link, joints, or both");
 
   if (const toml::node* gn = root.get("gravity")) {

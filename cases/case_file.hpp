@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "rfem/cases/names.hpp"
+#include "rfem/cases/sensor_spec.hpp"
 #include "rfem/core/model.hpp"
 #include "rfem/solvers/integrator.hpp"
 #include "rfem/solvers/statics.hpp"
@@ -88,6 +89,7 @@ struct Case {
   bool free_base = false;          ///< [base] kind = "free"
   std::string urdf;                ///< [base] urdf: the file the first joints came from ("" if none)
   std::vector<BodyFrame> frames;   ///< the URDF's links (what a link or joint may be mounted on by name)
+  std::vector<SensorSpec> sensors; ///< [[sensors]]: what a controller sees and a run records
   VecX joint_values, joint_rates;  ///< initial/held values and steady rates
   double gravity = 0.0;
   TipLoads loads;                  ///< on the link [loads] names (the last by default)

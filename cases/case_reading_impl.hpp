@@ -267,6 +267,8 @@ InputSpec read_input(const Reader& r, const toml::table& t, const std::string& p
 /// [base] kind = "free": six joints ahead of the case's (with parents that need no names).
 void read_base(const Reader& r, const toml::node* bn, const Materials& mats, const Sections& secs,
                const std::string& path, const std::string& case_dir, Case& c, std::vector<ParentRef>& parents);
+/// [[sensors]], checked against c's joints and links (after resolve_parents).
+std::vector<SensorSpec> read_sensors(const Reader& r, const toml::table& root, const Case& c);
 /// [link] (one link) or [[links]] into c.links; their parents into `parents`.
 void read_links(const Reader& r, const toml::table& root, const Materials& mats, const Sections& secs, Case& c,
                 std::vector<ParentRef>& parents);

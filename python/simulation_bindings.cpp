@@ -58,6 +58,9 @@ py::dict snapshot_dict(const Snapshot& y, const Model& model) {
   d["tau"] = tau;
   d["tip_position"] = tip;
   d["tip_deflection"] = defl;
+  for (const auto& [name, values] : y.sensors)  // (a case's sensor names never clash with these keys)
+    if (values.size() == 1) d[py::str(name)] = values[0];
+    else d[py::str(name)] = py::array_t<double>(static_cast<py::ssize_t>(values.size()), values.data());
   return d;
 }
 

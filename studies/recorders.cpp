@@ -24,6 +24,9 @@ void Hdf5Recorder::end(const RunResult& r) {
   o.t_reached = r.t_reached;
   o.stats = r.stats;
   run_->finish(o, r.wall_s, r.warnings);
+  if (r.sensors.rows > 0)  // (after finish: SWMR allows no new datasets while the run writes)
+    file_.write_table(r.name + "/sensors", r.sensors, r.sensor_columns, r.sensor_units,
+                      "the case's [[sensors]] at every output, as measured (noise, resolution)");
 }
 
 std::vector<std::string> write_views(const Case& cs, const Model& model, const std::string& results, const Warnings& warn) {

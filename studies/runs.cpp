@@ -9,6 +9,7 @@
 #include "rfem/core/positions.hpp"
 #include "rfem/studies/checkpoints.hpp"
 #include "rfem/studies/inputs.hpp"
+#include "rfem/studies/sensors.hpp"
 #include "rfem/studies/validity.hpp"
 
 namespace rfem {
@@ -63,6 +64,14 @@ RunBook::RunBook(std::string name, std::shared_ptr<const Model> model, const std
         obs->restore(*x);
       }
   }
+  if (!cs.sensors.empty()) {
+    sensors_ = std::make_unique<SensorBank>(cs, *model_);
+    s.sensor_columns = sensors_->columns();
+    s.sensor_units = sensors_->units();
+    s.sensors.cols = static_cast<long>(s.sensor_columns.size()) + 1;  // (time first)
+    s.sensor_columns.insert(s.sensor_columns.begin(), "time");
+    s.sensor_units.insert(s.sensor_units.begin(), "s");
+  }
   if (rq.keep_series) {
     s.series = std::make_shared<RunSeries>();
     s.series->layout = run_layout(*model_, cs.sim.flexible_every);
@@ -114,6 +123,11 @@ void RunBook::sample(const OutputSample& x) {
   }
   validity_->check(x.q, x.t);
   validity_->check_joints(x.q, x.v, x.tau, x.t);
+  if (sensors_) {  // (their own random stream: the same readings whatever a controller asks)
+    s.sensors.data.push_back(x.t);
+    sensors_->read(x.q, x.v, x.tau, s.sensors.data, 1);
+    ++s.sensors.rows;
+  }
   const double bal = x.energy_balance();
   if (std::isnan(balance0_)) balance0_ = bal;
   s.energy_drift = std::max(s.energy_drift, std::abs(bal - balance0_));

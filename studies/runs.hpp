@@ -62,6 +62,10 @@ struct RunResult {
   std::vector<std::string> warnings;
   std::shared_ptr<const Model> model;   ///< the model it ran (rigidified for `rigid`)
   std::shared_ptr<RunSeries> series;    ///< null unless the request keeps series
+  /// The case's [[sensors]] as measured at every output (noise and resolution included; the file's
+  /// `sensors` table): rows × columns, empty without sensors.
+  Table sensors;
+  std::vector<std::string> sensor_columns, sensor_units;
   bool completed() const { return status.is_completed(); }
 };
 
@@ -132,6 +136,7 @@ struct RunRequest {
 
 struct RunState;
 class ValidityMonitor;
+class SensorBank;
 
 /// The bookkeeping of one run as its outputs arrive — the observers, the series kept in memory,
 /// peaks, the energy balance's drift, the validity warnings, checkpoints of all that, the final
@@ -164,6 +169,7 @@ class RunBook {
   std::shared_ptr<const Model> model_;
   RunResult s_;
   std::unique_ptr<ValidityMonitor> validity_;
+  std::unique_ptr<SensorBank> sensors_;  // null without [[sensors]]
   std::vector<std::vector<double>> rows_;
   double balance0_ = NAN, wall_before_ = 0.0;
   std::chrono::steady_clock::time_point t0_;

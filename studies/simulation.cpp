@@ -12,6 +12,7 @@
 #include "rfem/studies/common.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/recorders.hpp"
+#include "rfem/studies/sensors.hpp"
 
 namespace rfem {
 
@@ -117,6 +118,7 @@ struct Simulation::Impl {
   std::unique_ptr<Hdf5Recorder> recorder;
   RunRequest rq;
   std::unique_ptr<RunBook> book;
+  std::unique_ptr<SensorBank> sensors;  // the snapshots' (the book records its own)
   std::unique_ptr<EquationsOfMotion> eq;
   std::unique_ptr<EsdirkStepper> stepper;  // (after eq: it refers to it)
   SampleSink sink;
@@ -223,6 +225,7 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
   m.rq.stop = m.opts.stop;
   m.rq.checkpoint_interval = 0.0;  // (`rfem run --resume` would go on without the caller's hand)
   m.book = std::make_unique<RunBook>("run", m.model, m.inputs, cs, m.rq, m.o);
+  if (!cs.sensors.empty()) m.sensors = std::make_unique<SensorBank>(cs, *m.model);
   m.eq = std::make_unique<EquationsOfMotion>(m.model, m.inputs, m.o.forces, m.rq.stop, m.o.linear_solver, m.o.parallel);
   if (m.eq->unknowns() == 0)
     throw CaseError(cs.path + ": joints: every joint follows a prescribed motion and there is no flexible link: nothing to step "
@@ -362,6 +365,17 @@ Snapshot Simulation::snapshot() {
   for (size_t l = 0; l < m.model->links.size(); ++l) {
     y.tip_position.push_back(tip_position(*m.model, static_cast<int>(l), s.q));
     y.tip_deflection.push_back(tip_deflection(*m.model, static_cast<int>(l), s.q));
+  }
+  if (m.sensors) {
+    std::vector<double> values;
+    m.sensors->read(s.q, s.v, s.tau, values, 0);
+    size_t k = 0;
+    for (size_t i = 0; i < m.sensors->size(); ++i) {
+      const auto w = static_cast<size_t>(m.sensors->width(i));
+      y.sensors.emplace_back(m.sensors->spec(i).name, std::vector<double>(values.begin() + static_cast<long>(k),
+                                                                          values.begin() + static_cast<long>(k + w)));
+      k += w;
+    }
   }
   return y;
 }

@@ -57,12 +57,14 @@ struct SimulationOptions {
 };
 
 /// What a lab measures at the simulation's time: joint encoders and torques (applied, or required
-/// by a prescribed motion), every link's tip in {0} and its deflection in {r}.
+/// by a prescribed motion), every link's tip in {0} and its deflection in {r}, and the case's sensors.
 struct Snapshot {
   double t = 0.0;
   VecX joint_q, joint_v, joint_tau;        ///< per joint [rad or m, /s, N m or N]
   std::vector<Vec3> tip_position;          ///< per link, in {0} [m]
   std::vector<Vec3> tip_deflection;        ///< per link: u1, u2 [m], θ [rad] in {r}
+  /// The case's [[sensors]] by name, as measured (noise, resolution; studies/sensors.hpp).
+  std::vector<std::pair<std::string, std::vector<double>>> sensors;
 };
 
 class Simulation {

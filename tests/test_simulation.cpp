@@ -10,6 +10,7 @@
 #include <filesystem>
 
 #include "rfem/results/reader.hpp"
+#include "rfem/studies/sensors.hpp"
 #include "rfem/studies/simulation.hpp"
 #include "tests/test_models.hpp"
 
@@ -249,4 +250,92 @@ TEST(Simulation, BadArgumentsAreRefusedWithOneLine) {
   }, c);
   EXPECT_NE(u.status.reason.find("no joint named 'elbow'"), std::string::npos) << u.status;
   std::filesystem::remove(path);
+}
+
+TEST(Simulation, StrainGaugesReadTheBeamsBendingMomentAndSensorsAreReproducible) {
+  // A 2 m cantilever held horizontally under gravity, in static equilibrium at t = 0: the bending
+  // moment at an sde at x is the weight beyond it times its lever arm, M = ρ A g (L − x)² / 2 (the
+  // rfes' masses lie beyond the sde exactly as the beam's), so a gauge at c above the axis reads
+  // ε = M c / (E Iy) (tension on top). The deflection is 4e-4 of L: the geometry's change of the
+  // lever arms is far below the 1e-4 asserted.
+  const Case cs = parse_case(R"(
+[materials.kane]
+E = 7.0e10
+G = 2.6923076923e10
+rho = 3000.0
+[sections.kane]
+A = 4.0e-4
+Iy = 2.0e-7
+Iz = 2.0e-7
+J = 4.0e-7
+[[joints]]
+name = "hub"
+input = { kind = "constant_rate", rate = 0.0 }
+[link]
+n = 20
+[[link.segments]]
+length = 2.0
+material = "kane"
+section = "kane"
+[gravity]
+g = 9.81
+[[sensors]]
+name = "gauge"
+kind = "strain"
+at = 0.5
+face = "z"
+distance = 0.01
+[[sensors]]
+name = "side"
+kind = "strain"
+at = 0.5
+face = "y"
+distance = 0.01
+[[sensors]]
+name = "noisy"
+kind = "strain"
+at = 0.5
+distance = 0.01
+noise = 1e-7
+quantum = 1e-8
+seed = 7
+[[sensors]]
+name = "enc"
+kind = "encoder"
+joint = "hub"
+[[sensors]]
+name = "tip"
+kind = "tip"
+[simulation]
+t_end = 0.02
+output_dt = 0.01
+)", "cantilever.toml");
+  const Model model = build_model(cs);
+  double x = NAN;  // the sde nearest 0.5 m
+  for (const Sde& e : model.links[0].d.sdes)
+    if (std::isnan(x) || std::abs(e.position - 0.5) < std::abs(x - 0.5)) x = e.position;
+  const double M = 3000.0 * 4.0e-4 * 9.81 * (2.0 - x) * (2.0 - x) / 2.0;
+  const double exact = M * 0.01 / (7.0e10 * 2.0e-7);
+  Simulation sim(cs, one_thread());
+  const Snapshot y = sim.snapshot();
+  ASSERT_EQ(y.sensors.size(), 5u);
+  EXPECT_EQ(y.sensors[0].first, "gauge");
+  EXPECT_NEAR(y.sensors[0].second.at(0), exact, 1e-4 * exact);
+  EXPECT_LT(std::abs(y.sensors[1].second.at(0)), 1e-6 * exact);  // no bending about z
+  EXPECT_EQ(y.sensors[3].second.size(), 2u);                     // encoder: q, q̇
+  EXPECT_NEAR(y.sensors[4].second.at(1), y.tip_deflection[0][1], 1e-15);
+  // Noise and resolution: multiples of the quantum, within 6σ of the exact value, the same again
+  // from the same seed.
+  const double noisy = y.sensors[2].second.at(0);
+  EXPECT_NEAR(noisy / 1e-8, std::round(noisy / 1e-8), 1e-6);
+  EXPECT_NEAR(noisy, exact, 6e-7 + 1e-8);
+  EXPECT_NE(noisy, y.sensors[0].second.at(0));
+  Simulation again(cs, one_thread());
+  EXPECT_EQ(again.snapshot().sensors[2].second, y.sensors[2].second);
+  // Recorded at every output (time first), the gauge's column as in the snapshot at t = 0.
+  sim.advance(sim.t_end());
+  const RunResult r = sim.finish();
+  ASSERT_EQ(r.sensors.rows, 3);
+  EXPECT_EQ(r.sensor_columns.at(4), "enc/q");
+  EXPECT_NEAR(r.sensors.at(0, 1), exact, 1e-4 * exact);
 }

@@ -1,0 +1,32 @@
+#pragma once
+// A sensor named in a case ([[sensors]], docs/case_files.md): what a lab would measure, for
+// controllers (studies/simulation.hpp) and as recorded outputs (studies/sensors.hpp evaluates them).
+#include <string>
+
+namespace rfem {
+
+struct SensorSpec {
+  enum class Kind {
+    Encoder,  ///< a joint's q and q̇ [rad or m, /s]
+    Torque,   ///< a joint's torque or force, applied or required [N m or N]
+    Tip,      ///< a link's tip: "position" (x, y, z in {0}) or "deflection" (u1, u2 [m], θ [rad] in {r})
+    Strain    ///< a strain gauge: axial strain of the fibre at `distance` from the axis towards +`face`,
+              ///< ε = M c / (E I) from the bending moment of the sde nearest `at` (tension positive)
+  };
+  std::string name;
+  Kind kind = Kind::Encoder;
+  std::string joint;       ///< Encoder, Torque
+  std::string link;        ///< Tip, Strain
+  std::string quantity;    ///< Tip: "position" or "deflection"
+  double at = 0.0;         ///< Strain: along the link [m]
+  char face = 'z';         ///< Strain: 'y' (bending about z) or 'z' (bending about y)
+  double distance = 0.0;   ///< Strain: from the elastic axis [m]
+  double noise = 0.0;      ///< standard deviation of Gaussian noise added to each value (its unit)
+  double quantum = 0.0;    ///< resolution: values rounded to multiples of it (0: none)
+  long seed = 0;           ///< of the noise (reproducible)
+  std::string where;       ///< "file:line: sensors.K" for messages
+};
+
+const char* to_string(SensorSpec::Kind k);
+
+}  // namespace rfem

@@ -1,0 +1,134 @@
+#include "rfem/studies/sensors.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "rfem/core/positions.hpp"
+
+namespace rfem {
+
+SensorBank::SensorBank(const Case& cs, const Model& model) : model_(model) {
+  for (const SensorSpec& s : cs.sensors) {
+    Resolved r;
+    r.spec = s;
+    for (int k = 0; k < 2; ++k) r.random[k].seed(static_cast<unsigned long long>(s.seed) * 2 + static_cast<unsigned long long>(k));
+    if (!s.joint.empty()) {
+      for (int j = 0; j < model.m(); ++j)
+        if (model.joints[j].name == s.joint) r.joint = j;
+      if (r.joint < 0) throw std::invalid_argument(s.where + ": no joint '" + s.joint + "' in the model");
+    }
+    if (!s.link.empty()) {
+      for (size_t l = 0; l < model.links.size(); ++l)
+        if (model.links[l].name == s.link) r.link = static_cast<int>(l);
+      if (r.link < 0) throw std::invalid_argument(s.where + ": no link '" + s.link + "' in the model");
+    }
+    if (s.kind == SensorSpec::Kind::Strain) {
+      // The sde nearest the gauge: RFEM's bending moment lives at the sdes (docs/formulation.md §3).
+      // A rigid link (the paper procedure's rigid run) has none: the gauge reads NaN there.
+      const Discretisation& d = model.links[static_cast<size_t>(r.link)].d;
+      double best = INFINITY;
+      for (size_t e = 0; e < d.sdes.size(); ++e)
+        if (std::abs(d.sdes[e].position - s.at) < best) {
+          best = std::abs(d.sdes[e].position - s.at);
+          r.sde = static_cast<int>(e);
+        }
+      if (r.sde < 0) {
+        sensors_.push_back(std::move(r));
+        continue;
+      }
+      const int l = cs.link_index(s.link);
+      const Segment& seg = cs.links[static_cast<size_t>(l)].link.segments.at(static_cast<size_t>(d.sdes[r.sde].segment));
+      r.EI = seg.material.E * (s.face == 'z' ? seg.section.Iy : seg.section.Iz);
+    }
+    sensors_.push_back(std::move(r));
+  }
+}
+
+int SensorBank::width(size_t i) const {
+  switch (sensors_[i].spec.kind) {
+    case SensorSpec::Kind::Encoder: return 2;
+    case SensorSpec::Kind::Tip: return 3;
+    default: return 1;
+  }
+}
+
+std::vector<std::string> SensorBank::columns() const {
+  std::vector<std::string> c;
+  for (const Resolved& r : sensors_) {
+    const std::string& n = r.spec.name;
+    switch (r.spec.kind) {
+      case SensorSpec::Kind::Encoder: c.insert(c.end(), {n + "/q", n + "/qd"}); break;
+      case SensorSpec::Kind::Tip:
+        if (r.spec.quantity == "position") c.insert(c.end(), {n + "/x", n + "/y", n + "/z"});
+        else c.insert(c.end(), {n + "/u1", n + "/u2", n + "/theta"});
+        break;
+      default: c.push_back(n);
+    }
+  }
+  return c;
+}
+
+std::vector<std::string> SensorBank::units() const {
+  std::vector<std::string> u;
+  for (const Resolved& r : sensors_) {
+    const bool prismatic = r.joint >= 0 && model_.joints[static_cast<size_t>(r.joint)].type == JointType::Prismatic;
+    switch (r.spec.kind) {
+      case SensorSpec::Kind::Encoder: u.insert(u.end(), {prismatic ? "m" : "rad", prismatic ? "m/s" : "rad/s"}); break;
+      case SensorSpec::Kind::Torque: u.push_back(prismatic ? "N" : "N m"); break;
+      case SensorSpec::Kind::Tip:
+        if (r.spec.quantity == "position") u.insert(u.end(), {"m", "m", "m"});
+        else u.insert(u.end(), {"m", "m", "rad"});
+        break;
+      case SensorSpec::Kind::Strain: u.push_back("1"); break;
+    }
+  }
+  return u;
+}
+
+void SensorBank::read(const VecX& q, const VecX& v, const VecX& tau, std::vector<double>& out, int stream) {
+  for (Resolved& r : sensors_) {
+    const size_t first = out.size();
+    switch (r.spec.kind) {
+      case SensorSpec::Kind::Encoder:
+        out.push_back(q[model_.joint_index(r.joint)]);
+        out.push_back(v[model_.joint_index(r.joint)]);
+        break;
+      case SensorSpec::Kind::Torque: out.push_back(tau[r.joint]); break;
+      case SensorSpec::Kind::Tip: {
+        if (r.spec.quantity == "position") {
+          const Vec3 p = tip_position(model_, r.link, q);
+          out.insert(out.end(), {p[0], p[1], p[2]});
+        } else {
+          const Vec3 u = tip_deflection(model_, r.link, q);
+          out.insert(out.end(), {u[0], u[1], u[2]});
+        }
+        break;
+      }
+      case SensorSpec::Kind::Strain: {
+        // M = k Δφ about the gauge's bending axis (the sde's rotational spring), ε = M c / (E I):
+        // a fibre towards +z is stretched by a positive Δφ about y, one towards +y by a negative
+        // Δφ about z (x turns towards −z, resp. +y).
+        if (r.sde < 0) {
+          out.push_back(NAN);
+          break;
+        }
+        const MountedLink& L = model_.links[static_cast<size_t>(r.link)];
+        const Sde& e = L.d.sdes[static_cast<size_t>(r.sde)];
+        const int a = r.spec.face == 'z' ? 4 : 5;  // φ2 or φ3 among an rfe's six coordinates
+        const double right = q[model_.rfe_index(r.link, e.right) + a];
+        const double left = e.left >= 0 ? q[model_.rfe_index(r.link, e.left) + a] : 0.0;
+        const double M = e.k[a - 3] * (right - left);
+        out.push_back((r.spec.face == 'z' ? 1.0 : -1.0) * M * r.spec.distance / r.EI);
+        break;
+      }
+    }
+    if (stream < 0) continue;
+    std::normal_distribution<double> noise(0.0, 1.0);
+    for (size_t i = first; i < out.size(); ++i) {
+      if (r.spec.noise > 0) out[i] += r.spec.noise * noise(r.random[stream]);
+      if (r.spec.quantum > 0) out[i] = r.spec.quantum * std::round(out[i] / r.spec.quantum);
+    }
+  }
+}
+
+}  // namespace rfem

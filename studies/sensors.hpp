@@ -1,0 +1,42 @@
+#pragma once
+// The case's sensors ([[sensors]], cases/sensor_spec.hpp) evaluated on a state: what a controller
+// sees (Snapshot::sensors) and what a run records (its `sensors` table). Noise and quantisation
+// come from each sensor's own random stream, seeded by the case: the same readings on every run.
+#include <random>
+#include <string>
+#include <vector>
+
+#include "rfem/cases/case_file.hpp"
+
+namespace rfem {
+
+class SensorBank {
+ public:
+  /// Resolves every sensor of the case against the model (joints, links, the sde of a strain gauge
+  /// and its section). std::invalid_argument for a model that is not the case's.
+  SensorBank(const Case& cs, const Model& model);
+  bool empty() const { return sensors_.empty(); }
+  size_t size() const { return sensors_.size(); }
+  const SensorSpec& spec(size_t i) const { return sensors_[i].spec; }
+  /// Values of sensor i (1 for a torque or a strain, 2 for an encoder, 3 for a tip).
+  int width(size_t i) const;
+  /// Every value's column name ("NAME", or "NAME/q", "NAME/qd", "NAME/u1" …) and unit.
+  std::vector<std::string> columns() const;
+  std::vector<std::string> units() const;
+  /// Every sensor's values at a state (full q, v and the joints' torques), appended to `out`:
+  /// exact, or as measured (noise, then quantisation) from the random streams of `stream`
+  /// (0: the controller's snapshots, 1: the recorded outputs), which advance.
+  void read(const VecX& q, const VecX& v, const VecX& tau, std::vector<double>& out, int stream = -1);
+
+ private:
+  struct Resolved {
+    SensorSpec spec;
+    int joint = -1, link = -1, sde = -1;
+    double EI = 0.0;  // strain: the bending stiffness of the gauge's section [N m²]
+    std::mt19937_64 random[2];
+  };
+  const Model& model_;
+  std::vector<Resolved> sensors_;
+};
+
+}  // namespace rfem
