@@ -40,6 +40,10 @@ struct InputSpec {
   std::shared_ptr<InputSpec> reference;
   double kp = 0, kd = 0;
   Feedforward feedforward = Feedforward::None;
+  /// The PD law as a digital controller: sampled every sample_time [s] (0: continuous), its output
+  /// held from `delay` samples later (solvers/inputs.hpp, sampled_law).
+  double sample_time = 0;
+  int delay = 0;
   bool none_given = false;  ///< a URDF joint the case gives no input: free, under zero torque
   bool prescribed() const { return is_motion(kind); }
 };

@@ -45,7 +45,7 @@ InputSpec read_input(const Reader& r, const toml::table& t, const std::string& p
     in.run = r.string(t, path, "run");
     in.joint = static_cast<int>(r.integer(t, path, "joint", 0, 1, 1000));
   } else if (in.kind == InputKind::Pd) {
-    r.check_keys(t, path, {"kind", "reference", "kp", "kd", "feedforward"});
+    r.check_keys(t, path, {"kind", "reference", "kp", "kd", "feedforward", "sample_time", "delay"});
     const toml::node* rn = t.get("reference");
     if (!rn || !rn->is_table())
       r.fail(rn ? rn : &t, path + ".reference", "a PD input needs a reference motion {kind = \"deployment\", …}");
@@ -54,6 +54,10 @@ InputSpec read_input(const Reader& r, const toml::table& t, const std::string& p
       r.fail(rn, path + ".reference.kind", "the reference must be a motion (deployment, spinup, constant_rate, table)");
     in.kp = r.non_negative(t, path, "kp", 0.0);
     in.kd = r.non_negative(t, path, "kd", 0.0);
+    if (t.get("sample_time")) in.sample_time = r.positive(t, path, "sample_time");  // (0: the continuous law)
+    in.delay = static_cast<int>(r.integer(t, path, "delay", 0, 0, 1000000));
+    if (in.delay > 0 && in.sample_time <= 0)
+      r.fail(t.get("delay"), path + ".delay", "a delay of whole samples needs a sample_time");
     const std::string ff = r.string(t, path, "feedforward", std::string("none"));
     if (!parse(ff, in.feedforward))
       r.fail(t.get("feedforward"), path + ".feedforward", "must be \"none\" or \"rigid\" (got \"" + ff + "\")");

@@ -181,11 +181,49 @@ struct EsdirkStepper::Impl {
   size_t next_break = 0;
   long n_out = 0, k_out = 1, steps_this_output = 0, attempts_this_output = 0;
   bool started = false;
+  // Digital laws (TorqueLaw::sample_time > 0): their joints, the columns of their joints among the
+  // unknowns, the index of each one's next sample.
+  std::vector<int> sampled, sampled_col;
+  std::vector<long> next_sample;
 
   Impl(EquationsOfMotion& e, const IntegratorOptions& opts)
       : eq(e), o(opts), T(load_tableau(opts.esdirk_table)), u(e.unknowns()), s(T.s), r(u), alpha(s, VecX::Zero(u)),
         Ps(s), cq(s), cv(s), w(2 * u), Qk(u), Vk(u), Q(u), V(u), breaks(e.breakpoints(opts.t_end)),
-        n_out(output_count(opts)) {}
+        n_out(output_count(opts)) {
+    for (int j = 0; j < static_cast<int>(e.inputs().size()); ++j)
+      if (const JointInput& in = e.inputs()[j]; !in.prescribed() && in.torque->sample_time() > 0) {
+        sampled.push_back(j);
+        sampled_col.push_back(e.base_col()[j]);
+        next_sample.push_back(0);
+      }
+  }
+
+  double sample_time_of(size_t i) const { return eq.inputs()[sampled[i]].torque->sample_time(); }
+  // The next sample of any digital law after t (t_end if none).
+  double next_sample_time() const {
+    double t_next = o.t_end;
+    for (size_t i = 0; i < sampled.size(); ++i) t_next = std::min(t_next, next_sample[i] * sample_time_of(i));
+    return t_next;
+  }
+  // The digital laws whose sample falls on t sample the joint there; the accelerations and powers
+  // are then those of the new held values (the right limit).
+  void sample_due() {
+    bool changed = false;
+    for (size_t i = 0; i < sampled.size(); ++i) {
+      const double ts = sample_time_of(i);
+      while (next_sample[i] * ts <= t + 1e-12 * std::max(1.0, t)) {
+        if (std::abs(next_sample[i] * ts - t) <= 1e-12 * std::max(1.0, t)) {
+          eq.inputs()[sampled[i]].torque->sample(t, q[sampled_col[i]], v[sampled_col[i]]);
+          changed = true;
+        }
+        ++next_sample[i];
+      }
+    }
+    if (!changed) return;
+    a = eq.accelerations(t, q.data(), v.data());
+    P = eq.residual(t, q.data(), v.data(), a.data(), r.data());
+    ++st.residual_evals;
+  }
 
   void weights(const VecX& qa, const VecX& va, const VecX* qb, const VecX* vb) {
     for (int i = 0; i < u; ++i) {
@@ -245,6 +283,12 @@ RunStatus EsdirkStepper::Impl::start(SampleEmitter& emit) {
     if (!emit(s0)) return emit.failure();
   }
 
+  t = resume ? resume->t : 0.0;
+  try {
+    sample_due();  // (a digital law's first value: at t = 0, or where a resumed run stands)
+  } catch (const std::exception& e) {
+    return RunStatus::failed(at_start(e.what()));
+  }
   // Initial step (Hairer & Wanner I, II.4): 1 % of the time for y to change by its own size.
   weights(q, v, nullptr, nullptr);
   {
@@ -297,11 +341,11 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
       // stretch a step that would leave a sliver.
       while (next_break < breaks.size() && breaks[next_break] <= t * (1 + 1e-14)) ++next_break;
       const double t_law = next_break < breaks.size() ? breaks[next_break] : o.t_end;
-      const double t_stop = std::min(t_law, until);
+      const double t_stop = std::min({t_law, until, next_sample_time()});
       // The caller's stops (a controller's samples) come often: two equal steps instead of a step
       // and a sliver, and the step after a stop sized from what the controller proposed before it
       // (a run without such stops takes the same steps as always).
-      const bool callers = until < t_law;
+      const bool callers = t_stop < t_law;
       const double h_proposed = h;
       const bool lands = t + 1.05 * h >= t_stop;
       if (lands) h = t_stop - t;
@@ -455,7 +499,9 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
       last_rejected = nonfinite = false;
       h = o.fixed_step > 0 ? o.fixed_step : (callers ? std::max(h, h_proposed) : h) * fac;
       if (o.max_step > 0) h = std::min(h, o.max_step);
-      if (!emit.checkpoint([&] { return state(); })) return emit.failure();
+      sample_due();
+      // (A digital law's held values are not in the integrator's state: no checkpoints to resume from.)
+      if (sampled.empty() && !emit.checkpoint([&] { return state(); })) return emit.failure();
     }
   } catch (const std::exception& e) {
     return fail(e.what());

@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cmath>
+#include <deque>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -213,6 +214,45 @@ class PdTorque : public TorqueLaw {
 std::shared_ptr<TorqueLaw> pd_law(std::shared_ptr<MotionLaw> reference, double kp, double kd,
                                   std::shared_ptr<TorqueLaw> feedforward) {
   return std::make_shared<PdTorque>(std::move(reference), kp, kd, std::move(feedforward));
+}
+
+namespace {
+
+class SampledTorque : public TorqueLaw {
+ public:
+  SampledTorque(std::shared_ptr<TorqueLaw> law, double ts, int delay) : law_(std::move(law)), ts_(ts), delay_(delay) {
+    if (!law_) throw std::invalid_argument("a sampled law needs a law");
+    if (!(ts_ > 0) || !std::isfinite(ts_)) throw std::invalid_argument("sample_time must be positive");
+    if (delay_ < 0) throw std::invalid_argument("delay must be a whole number of samples, 0 or more");
+  }
+  double at(double) const override { return held_; }
+  double at(double, double, double) const override { return held_; }
+  double sample_time() const override { return ts_; }
+  void sample(double t, double q, double v) override {
+    const double u = law_->at(t, q, v);
+    if (t <= 0.0) {  // a run's first sample: the controller at rest before it
+      pending_.clear();
+      held_ = u;
+    }
+    pending_.push_back(u);
+    if (pending_.size() > static_cast<size_t>(delay_)) {
+      held_ = pending_.front();
+      pending_.pop_front();
+    }
+  }
+
+ private:
+  std::shared_ptr<TorqueLaw> law_;
+  double ts_;
+  int delay_;
+  double held_ = 0.0;
+  std::deque<double> pending_;
+};
+
+}  // namespace
+
+std::shared_ptr<TorqueLaw> sampled_law(std::shared_ptr<TorqueLaw> law, double sample_time, int delay) {
+  return std::make_shared<SampledTorque>(std::move(law), sample_time, delay);
 }
 
 std::shared_ptr<MotionLaw> deployment_law(double psi0, double alpha, double T) {

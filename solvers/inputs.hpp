@@ -34,6 +34,11 @@ class TorqueLaw {
   virtual double stiffness() const { return 0.0; }
   virtual double damping() const { return 0.0; }
   virtual std::vector<double> breakpoints() const { return {}; }
+  /// A law a digital controller samples (sampled_law): its sample time [s]; 0 for a continuous law.
+  virtual double sample_time() const { return 0.0; }
+  /// At a sample time t with the joint's q, v there (the integrator calls it, its steps ending at
+  /// every sample): the law computes its next output.
+  virtual void sample(double /*t*/, double /*q*/, double /*v*/) {}
 };
 
 /// Kane's deployment law (the dimensionally consistent form, docs/formulation.md §3):
@@ -60,6 +65,11 @@ std::shared_ptr<TorqueLaw> spline_torque(std::vector<double> t, std::vector<doub
 /// feedback only corrects what the link's flexibility adds. kp, kd ≥ 0; ff may be null.
 std::shared_ptr<TorqueLaw> pd_law(std::shared_ptr<MotionLaw> reference, double kp, double kd,
                                   std::shared_ptr<TorqueLaw> feedforward);
+/// `law` run as a digital controller: evaluated at the joint's state at t_k = k·sample_time and held
+/// (zero-order hold) from t_{k+delay} until the next value takes effect; before that it holds the
+/// value of t = 0 (the controller was at rest before the run). A held value does not depend on the
+/// joint's state between samples (no stiffness or damping of its own).
+std::shared_ptr<TorqueLaw> sampled_law(std::shared_ptr<TorqueLaw> law, double sample_time, int delay);
 std::shared_ptr<TorqueLaw> torque_function(std::function<double(double)> f, std::vector<double> breakpoints = {});
 
 /// Reads a two-column CSV (time, value), '#' comments and one optional header line allowed.

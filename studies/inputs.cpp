@@ -142,6 +142,12 @@ std::vector<JointInput> joint_inputs(const Case& cs, const Warnings& warn) {
       out[j].torque = pd_law(reference[j], in.kp, in.kd, ff[j].torque);
     }
   }
+  for (size_t j = 0; j < out.size(); ++j)  // digital PD laws: sampled, held
+    if (const InputSpec& in = cs.inputs[j]; in.kind == InputKind::Pd && in.sample_time > 0) {
+      if (cs.sim.options.kind == IntegratorKind::Bdf)
+        throw CaseError(in.where + ".sample_time: a sampled law needs simulation.integrator = \"esdirk\" (its steps end at the samples)");
+      out[j].torque = sampled_law(out[j].torque, in.sample_time, in.delay);
+    }
   return out;
 }
 

@@ -339,3 +339,33 @@ output_dt = 0.01
   EXPECT_EQ(r.sensor_columns.at(4), "enc/q");
   EXPECT_NEAR(r.sensors.at(0, 1), exact, 1e-4 * exact);
 }
+
+TEST(Simulation, TheBuiltInDigitalPdIsTheSameLawAsAControllerBitForBit) {
+  // `pd` with sample_time: the case's law sampled and held by the integrator itself; the same law
+  // written as a controller at the same rate takes the same steps on the same values.
+  const Case continuous = pd_hub();
+  const Case digital = with_overrides(continuous, {"joints.0.input.sample_time=2e-3"});
+  RunRequest rq;
+  rq.threads = 1;
+  const RunResult builtin = run_case(digital, rq).at(0);
+  ASSERT_TRUE(builtin.completed()) << builtin.status;
+  const auto reference = spinup_law(0.0, 2.0, 1.0);
+  const Controller pd = [&](double t, const Snapshot& y) {
+    const MotionSample r = reference->at(t);
+    ControlOutput u;
+    u.torques["hub"] = 4000.0 * (r.q - y.joint_q[0]) + 800.0 * (r.qd - y.joint_v[0]);
+    return u;
+  };
+  ControlOptions c;
+  c.sample_time = 2e-3;
+  const RunResult loop = run_controlled(with_overrides(continuous, {"joints.0.input={kind=\"torque\", value=0.0}", "joints.0.drive={inertia=50.0}"}),
+                                        one_thread(), pd, c);
+  ASSERT_TRUE(loop.completed()) << loop.status;
+  EXPECT_EQ(builtin.stats.steps, loop.stats.steps);
+  EXPECT_EQ(series(builtin, "joint_q").data, series(loop, "joint_q").data);
+  EXPECT_EQ(series(builtin, "tip_deflection").data, series(loop, "tip_deflection").data);
+  // A delay of one sample is another law (later by Ts), and a sample time with BDF is refused.
+  const RunResult late = run_case(with_overrides(digital, {"joints.0.input.delay=1"}), rq).at(0);
+  EXPECT_NE(series(late, "joint_q").data, series(builtin, "joint_q").data);
+  EXPECT_THROW(run_case(with_overrides(digital, {"simulation.integrator=\"bdf\""}), rq), CaseError);
+}
