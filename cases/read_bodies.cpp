@@ -30,13 +30,16 @@ Material read_material(const Reader& r, const toml::table& t, const std::string&
   // Each value against what real materials span (kPlausible*), before any ratio of two: a ratio
   // with a slipped unit would blame the sound one (E = 70 Pa made G > E/2).
   if (m.E < kPlausibleE.lo)
-    r.doubt(t.get("E"), path + ".E", "E = " + Reader::fmt(m.E) + " Pa is very small: units are SI (Pa), not GPa or MPa (the softest solids a link is made of have about 1e5 Pa)");
+    r.doubt(t.get("E"), path + ".E", "E = " + Reader::fmt(m.E) +
+                                         " Pa is very small: units are SI (Pa), not GPa or MPa (the softest solids a link is made of have about 1e5 Pa)");
   if (m.E > kPlausibleE.hi) r.doubt(t.get("E"), path + ".E", "E = " + Reader::fmt(m.E) + " Pa is stiffer than diamond (1.2e12 Pa): units are Pa");
   if (m.G < kPlausibleG.lo)
-    r.doubt(t.get("G"), path + ".G", "G = " + Reader::fmt(m.G) + " Pa is very small: units are SI (Pa), not GPa or MPa (soft elastomers have about 3e4 Pa)");
+    r.doubt(t.get("G"), path + ".G", "G = " + Reader::fmt(m.G) +
+                                         " Pa is very small: units are SI (Pa), not GPa or MPa (soft elastomers have about 3e4 Pa)");
   if (m.G > kPlausibleG.hi) r.doubt(t.get("G"), path + ".G", "G = " + Reader::fmt(m.G) + " Pa is stiffer than diamond (5e11 Pa): units are Pa");
   if (m.rho < kPlausibleRho.lo)
-    r.doubt(t.get("rho"), path + ".rho", "rho = " + Reader::fmt(m.rho) + " kg/m^3 is very small: units are SI (kg/m^3), not g/cm^3 (the lightest structural foams have 10 kg/m^3)");
+    r.doubt(t.get("rho"), path + ".rho", "rho = " + Reader::fmt(m.rho) +
+                                             " kg/m^3 is very small: units are SI (kg/m^3), not g/cm^3 (the lightest structural foams have 10 kg/m^3)");
   if (m.rho > kPlausibleRho.hi)
     r.doubt(t.get("rho"), path + ".rho", "rho = " + Reader::fmt(m.rho) + " kg/m^3 is denser than any material (osmium: 2.26e4): units are kg/m^3");
   if (kPlausibleE.holds(m.E) && kPlausibleG.holds(m.G) && m.G > m.E / 2)
