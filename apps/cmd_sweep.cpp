@@ -8,6 +8,7 @@
 
 #include "commands.hpp"
 #include "signals.hpp"
+#include "rfem/results/errors.hpp"
 #include "rfem/studies/sweep.hpp"
 
 namespace rfem::app {
@@ -21,6 +22,14 @@ std::string duration(double s) {
   return fmt::format("{:.1f} h", s / 3600);
 }
 
+SweepLock lock_sweep(const Sweep& s) {
+  try {
+    return SweepLock(s);
+  } catch (const ResultsError& e) {  // refused before anything was written: exit 2, as rfem run's unwritable output
+    throw CaseError(e.what());
+  }
+}
+
 }  // namespace
 
 void print_sweep_progress(const SweepProgress& p) {
@@ -32,14 +41,17 @@ void print_sweep_progress(const SweepProgress& p) {
 
 int print_sweep(const Sweep& s, const std::vector<SweepRow>& rows, const StopToken& stop, bool json, bool quiet) {
   if (isatty(fileno(stderr))) fmt::print(stderr, "\r{:80}\r", "");
-  int done = 0, failed = 0;
-  for (const SweepRow& r : rows) (r.completed() ? done : failed) += r.status != "pending" && r.status != "interrupted";
+  int done = 0, failed = 0, interrupted = 0;
+  for (const SweepRow& r : rows) {
+    if (r.interrupted()) ++interrupted;
+    else if (!r.pending()) ++(r.completed() ? done : failed);
+  }
   if (json) {
     nlohmann::json js = nlohmann::json::array();
     for (size_t k = 0; k < rows.size(); ++k) {
       nlohmann::json q = nlohmann::json::object();
       for (size_t i = 0; i < s.quantities.size(); ++i) q[s.quantities[i]] = std::isfinite(rows[k].values[i]) ? nlohmann::json(rows[k].values[i]) : nlohmann::json();
-      js.push_back({{"point", k}, {"overrides", s.points[k].overrides}, {"status", rows[k].status}, {"quantities", q},
+      js.push_back({{"point", k}, {"overrides", s.points[k].overrides}, {"status", rows[k].status_text()}, {"quantities", q},
                     {"wall_s", std::isfinite(rows[k].wall_s) ? nlohmann::json(rows[k].wall_s) : nlohmann::json()},
                     {"steps", rows[k].steps}, {"file", s.points[k].file}});
     }
@@ -63,12 +75,13 @@ int print_sweep(const Sweep& s, const std::vector<SweepRow>& rows, const StopTok
         const double v = rows[k].values[i];
         line += std::isfinite(v) ? fmt::format(" {:>{}.9e}", v, qw[i]) : fmt::format(" {:>{}}", "-", qw[i]);
       }
-      fmt::print("{}  {}\n", line, rows[k].status);
+      fmt::print("{}  {}\n", line, rows[k].status_text());
     }
-    fmt::print("{} of {} runs completed, {} failed; index {} (runs in {}/)\n", done, rows.size(), failed, s.index, s.directory);
+    fmt::print("{} of {} runs completed, {} failed{}; index {} (runs in {}/)\n", done, rows.size(), failed,
+               interrupted > 0 ? fmt::format(", {} interrupted", interrupted) : "", s.index, s.directory);
   }
   if (stop.requested()) return 128 + std::max(stop.signal(), 2);
-  return failed > 0 ? 1 : 0;
+  return failed > 0 || interrupted > 0 ? 1 : 0;
 }
 
 int run_sweep_command(const SweepOptions& o, bool json, bool quiet) {
@@ -76,6 +89,7 @@ int run_sweep_command(const SweepOptions& o, bool json, bool quiet) {
   for (const char* var : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"})
     if (const char* world = std::getenv(var); world && std::atoi(world) > 1) return run_sweep_mpi(o, json, quiet);
   const Sweep s = read_sweep(o.path, o.output);  // every point checked before any run
+  const SweepLock lock = lock_sweep(s);
   SweepRequest rq;
   rq.jobs = o.jobs;
   rq.retry_failed = o.retry_failed;
@@ -83,7 +97,7 @@ int run_sweep_command(const SweepOptions& o, bool json, bool quiet) {
   const bool show = !quiet && !json;
   if (show) rq.progress = print_sweep_progress;
   const SignalStop signals(rq.stop);
-  const std::vector<SweepRow> rows = run_sweep(s, rq);
+  const std::vector<SweepRow> rows = run_sweep(s, rq, lock);
   return print_sweep(s, rows, rq.stop, json, quiet);
 }
 

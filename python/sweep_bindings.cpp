@@ -11,7 +11,6 @@
 #include <csignal>
 #include <mutex>
 #include <thread>
-#include <type_traits>
 
 #include "arguments.hpp"
 #include "rfem/solvers/run_status.hpp"
@@ -32,19 +31,9 @@ int point(const Sweep& s, py::handle k) {
                                         "a point of the sweep, 0 to " + std::to_string(s.points.size() - 1)));
 }
 
-// A row's status as text, whether the library keeps it as text or as a RunStatus (issue #34 moves it).
-template <class S>
-std::string status_text(const S& s) {
-  if constexpr (std::is_same_v<S, std::string>) return s; else return s.to_string();
-}
-template <class S>
-void set_status(S& s, const std::string& text) {
-  if constexpr (std::is_same_v<S, std::string>) s = text; else s = RunStatus::parse(text);
-}
-
 py::dict row_dict(const SweepRow& r) {
   py::dict d;
-  d["status"] = status_text(r.status);
+  d["status"] = r.status_text();  // "pending" or the RunStatus's text
   d["wall_s"] = r.wall_s;
   d["t_reached"] = r.t_reached;
   d["steps"] = r.steps;
@@ -66,7 +55,7 @@ SweepRow dict_row(py::handle row, const std::string& name) {
     return py::float_(py::reinterpret_borrow<py::object>(v)).cast<double>();
   };
   SweepRow r;
-  set_status(r.status, args::text(d["status"], key("status")));
+  r.status = SweepRow::parse_status(args::text(d["status"], key("status")));
   r.wall_s = number("wall_s");
   r.t_reached = number("t_reached");
   r.steps = d.contains("steps") ? args::integer(d["steps"], key("steps"), 0, LONG_MAX, "a count, 0 or more") : 0;

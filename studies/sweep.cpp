@@ -1,11 +1,16 @@
 #include "rfem/studies/sweep.hpp"
 
+#include <fcntl.h>
 #include <fmt/core.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -134,6 +139,10 @@ Sweep read_sweep(const std::string& path, const std::string& index) {
   };
   s.set = strings("set");
   s.quantities = strings("quantities");
+  // The index is the quantities' table: a sweep without one has nothing to record.
+  if (s.quantities.empty())
+    r.fail(st.get("quantities") ? st.get("quantities") : &st, "sweep.quantities",
+           std::string(st.get("quantities") ? "is empty" : "missing") + ": name at least one quantity to record, e.g. quantities = [\"peak:u1\"]");
   const std::string combine = r.string(st, "sweep", "combine", std::string("grid"));
   if (combine != "grid" && combine != "zip") r.fail(st.get("combine"), "sweep.combine", "must be \"grid\" or \"zip\" (got \"" + combine + "\")");
   s.zip = combine == "zip";
@@ -253,19 +262,19 @@ SweepRow run_point(const Sweep& s, int k, const StopToken& stop, int threads, co
       runs = run_case(c, model, joint_inputs(c, warn), rq);
       file.close();
     }
-    row.status = "completed";
+    row.status = RunStatus::completed();
     for (const RunResult& r : runs) {
       row.wall_s += r.wall_s;
       row.steps += r.stats.steps;
       row.residual_evals += r.stats.residual_evals;
       row.t_reached = r.t_reached;
-      if (!r.completed()) {
-        row.status = (runs.size() > 1 ? r.name + " " : std::string()) + r.status.to_string();
+      if (!r.completed()) {  // (which of the case's runs, when it has more than one)
+        row.status = r.status.kind == RunStatus::Kind::Failed && runs.size() > 1 ? RunStatus::failed(r.name + ": " + r.status.reason) : r.status;
         break;
       }
     }
     if (stop.requested()) {  // not finished: goes on next time (no sweep_status in its file)
-      row.status = "interrupted";
+      row.status = RunStatus::interrupted(stop.signal());
       return row;
     }
     if (row.completed()) {
@@ -279,10 +288,10 @@ SweepRow run_point(const Sweep& s, int k, const StopToken& stop, int threads, co
     file.write_table("sweep_statistics", {1, 4, {row.wall_s, row.t_reached, static_cast<double>(row.steps), static_cast<double>(row.residual_evals)}},
                      {"wall_s", "t_reached", "steps", "residual_evals"}, {"s", "s", "1", "1"}, "the run's cost");
     file.write_attribute("/", "sweep_overrides", joined(p.overrides, "\n"));
-    file.write_attribute("/", "sweep_status", row.status);  // last: a file without it did not finish
+    file.write_attribute("/", "sweep_status", row.status_text());  // last: a file without it did not finish
     file.close();
   } catch (const std::exception& e) {
-    row.status = stop.requested() ? "interrupted" : std::string("failed: ") + e.what();
+    row.status = stop.requested() ? RunStatus::interrupted(stop.signal()) : RunStatus::failed(e.what());
   }
   return row;
 }
@@ -296,7 +305,8 @@ std::optional<SweepRow> finished_point(const Sweep& s, int k) {
     const std::string status = in.attribute("/", "sweep_status");
     if (status.empty() || in.attribute("/", "sweep_overrides") != joined(p.overrides, "\n")) return std::nullopt;
     SweepRow row;
-    row.status = status;
+    row.status = RunStatus::parse(status);
+    if (!row.completed() && row.status->kind != RunStatus::Kind::Failed) return std::nullopt;  // (only finished runs are kept)
     const Table st = in.table("sweep_statistics");
     row.wall_s = st.at(0, 0);
     row.t_reached = st.at(0, 1);
@@ -319,7 +329,7 @@ void write_index(const Sweep& s, const std::vector<SweepRow>& rows) {
   const long R = static_cast<long>(rows.size()), P = static_cast<long>(s.parameters.size()), Q = static_cast<long>(s.quantities.size());
   if (!fs::path(s.index).parent_path().empty()) fs::create_directories(fs::path(s.index).parent_path());
   const std::string tmp = s.index + ".tmp";
-  {
+  try {
     FileDescription d;
     d.command_line = "rfem sweep " + s.path;
     d.case_path = s.case_path;
@@ -335,7 +345,7 @@ void write_index(const Sweep& s, const std::vector<SweepRow>& rows) {
       par.data.insert(par.data.end(), p.values.begin(), p.values.end());
       for (long q = 0; q < Q; ++q) qv.data.push_back(q < static_cast<long>(r.values.size()) ? r.values[static_cast<size_t>(q)] : NAN);
       st.data.insert(st.data.end(), {r.wall_s, r.t_reached, static_cast<double>(r.steps), static_cast<double>(r.residual_evals)});
-      status.push_back(r.status);
+      status.push_back(r.status_text());
       files.push_back(fs::path(p.file).lexically_relative(home.empty() ? fs::path(".") : home).string());
       overrides.push_back(joined(p.overrides, " "));
     }
@@ -350,11 +360,34 @@ void write_index(const Sweep& s, const std::vector<SweepRow>& rows) {
     for (long k = 0; k < R; ++k)
       if (fs::exists(s.points[static_cast<size_t>(k)].file)) w.write_external_link(fmt::format("runs/{}", fs::path(files[static_cast<size_t>(k)]).stem().string()), files[static_cast<size_t>(k)], "/");
     w.close();
+    std::error_code ec;
+    fs::rename(tmp, s.index, ec);
+    if (ec) throw ResultsError(s.index + ": cannot write the index: " + ec.message());
+  } catch (...) {  // (the writer closed by now) no half-written index left beside the valid one
+    std::error_code ec;
+    if (fs::is_regular_file(tmp, ec)) fs::remove(tmp, ec);
+    throw;
   }
-  std::error_code ec;
-  fs::rename(tmp, s.index, ec);
-  if (ec) throw ResultsError(s.index + ": cannot write the index: " + ec.message());
 }
+
+SweepLock::SweepLock(const Sweep& s) {
+  std::error_code ec;
+  if (fs::exists(s.index, ec) && !fs::is_regular_file(s.index, ec)) throw ResultsError(s.index + ": is not a file (a directory?): give the index's file name");
+  fs::create_directories(s.directory, ec);
+  if (ec) throw ResultsError(s.index + ": cannot write the sweep's runs in " + s.directory + "/: " + ec.message());
+  const std::string path = (fs::path(s.directory) / "sweep.lock").string();
+  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw ResultsError(s.index + ": cannot write the sweep's runs in " + s.directory + "/: " + std::strerror(errno));
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int e = errno;
+    ::close(fd_);
+    if (e == EWOULDBLOCK)
+      throw ResultsError(s.index + ": another sweep is writing this index and its runs (" + path + " is locked): wait for it to end");
+    throw ResultsError(s.index + ": cannot lock " + path + ": " + std::strerror(e));
+  }
+}
+
+SweepLock::~SweepLock() { ::close(fd_); }  // (closing releases the lock)
 
 std::vector<int> plan_sweep(const Sweep& s, bool retry_failed, std::vector<SweepRow>& rows) {
   rows.assign(s.points.size(), SweepRow{});
@@ -371,6 +404,11 @@ std::vector<int> plan_sweep(const Sweep& s, bool retry_failed, std::vector<Sweep
 }
 
 std::vector<SweepRow> run_sweep(const Sweep& s, const SweepRequest& rq) {
+  const SweepLock lock(s);
+  return run_sweep(s, rq, lock);
+}
+
+std::vector<SweepRow> run_sweep(const Sweep& s, const SweepRequest& rq, const SweepLock&) {
   std::vector<SweepRow> rows;
   const std::vector<int> todo = plan_sweep(s, rq.retry_failed, rows);
   SweepProgress pr;
@@ -379,7 +417,7 @@ std::vector<SweepRow> run_sweep(const Sweep& s, const SweepRequest& rq) {
   double cost_left = 0.0;
   for (int k : todo) cost_left += s.points[static_cast<size_t>(k)].cost;
   for (const SweepRow& r : rows)
-    if (r.status != "pending") ++(r.completed() ? pr.done : pr.failed);
+    if (!r.pending()) ++(r.completed() ? pr.done : pr.failed);
   write_index(s, rows);
   const int jobs = std::max(1, std::min(rq.jobs > 0 ? rq.jobs : static_cast<int>(std::thread::hardware_concurrency()), static_cast<int>(todo.size())));
   std::mutex lock;
@@ -408,7 +446,7 @@ std::vector<SweepRow> run_sweep(const Sweep& s, const SweepRequest& rq) {
       const std::lock_guard<std::mutex> g(lock);
       --pr.running;
       rows[static_cast<size_t>(k)] = row;
-      if (row.status == "interrupted") continue;
+      if (row.interrupted()) continue;
       ++(row.completed() ? pr.done : pr.failed);
       cost_done += s.points[static_cast<size_t>(k)].cost;
       pr.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -3,7 +3,11 @@
 # time, two at a time and (when built with MPI: $2 = 1) across 3 MPI ranks; its peaks converge with
 # observed order 2 ± 0.3 in n at each T; a sweep killed with SIGKILL, or stopped by SIGINT (exit
 # 130), leaves a valid index and a rerun redoes only what did not finish (the interrupted point
-# from its checkpoint), ending with the uninterrupted table bit for bit; bad sweep files give one line and exit 2; rfem plot draws the index.
+# from its checkpoint), ending with the uninterrupted table bit for bit; under MPI, SIGINT or
+# SIGTERM to one worker rank ends the sweep the same way (exit 128 + signal, "N interrupted");
+# a second sweep on an index another holds, an unwritable output and bad sweep files give one line
+# and exit 2 with nothing touched; an index that cannot be written leaves no .tmp; rfem plot draws
+# the index.
 set -euo pipefail
 source "$(dirname "$0")/cli_test_env.sh"
 mpi=${2:-0}
@@ -125,10 +129,54 @@ if [ "$mpi" = 1 ]; then  # a worker rank killed: OpenMPI ends the job; the rerun
   OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -n 3 --oversubscribe "$rfem" sweep k.toml -q 2>/dev/null
   [ "$(completed k.h5)" = 4 ] || { echo "FAIL: killed rank: the rerun did not finish the sweep"; exit 1; }
   echo "ok   a worker rank killed after $done_before of 4 points: mpirun exit $code, the rerun ran the other $((4 - done_before))"
+  # SIGINT or SIGTERM to worker rank 1 alone (not to mpirun): the sweep stops as a local one does.
+  for sig in INT TERM; do
+    rm -rf k.h5 k.runs
+    OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -n 3 --oversubscribe "$rfem" sweep k.toml > mpi.out 2>/dev/null &
+    pid=$!
+    # (the index exists once every rank has installed its signal handlers; the first points run)
+    for i in $(seq 1 6000); do [ -e k.h5 ] && break; kill -0 "$pid" 2>/dev/null || break; sleep 0.01; done
+    worker=""
+    for p in $(pgrep -f "^$rfem sweep k.toml"); do
+      [ "$(tr '\0' '\n' < /proc/$p/environ 2>/dev/null | sed -n 's/^OMPI_COMM_WORLD_RANK=//p')" = 1 ] && worker=$p
+    done
+    [ -n "$worker" ] || { echo "FAIL: SIG$sig to a worker: no rank 1 found"; exit 1; }
+    kill -$sig "$worker"
+    set +e
+    wait "$pid"
+    code=$?
+    set -e
+    want=$([ $sig = INT ] && echo 130 || echo 143)
+    # (completed, interrupted by the signal, anything else but pending)
+    counts=$(/usr/bin/python3 -c "
+import h5py; s = [str(x) for x in h5py.File('k.h5', 'r').attrs['status']]
+i = s.count('interrupted (signal $((want - 128)))')
+print(s.count('completed'), i, len(s) - s.count('completed') - s.count('pending') - i)")
+    read -r n_done n_int n_other <<< "$counts"
+    summary=$(tail -1 mpi.out)
+    if [ "$code" != "$want" ] || [ "$n_done" = 4 ] || [ "$n_other" != 0 ] || { [ "$n_int" -gt 0 ] && ! grep -qF ", $n_int interrupted;" <<< "$summary"; }; then
+      echo "FAIL: SIG$sig to worker rank 1: mpirun exit $code (want $want), index $counts, summary: $summary"; exit 1
+    fi
+    OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -n 3 --oversubscribe "$rfem" sweep k.toml -q 2>/dev/null
+    [ "$(completed k.h5)" = 4 ] || { echo "FAIL: SIG$sig to a worker: the rerun did not finish the sweep"; exit 1; }
+    echo "ok   SIG$sig to worker rank 1 after $n_done of 4 points: mpirun exit $code, $n_int interrupted ($summary); the rerun finished"
+  done
 fi
 cp k.h5 resumed.h5
 rm -rf k.h5 k.runs
-"$rfem" sweep k.toml --jobs 2 -q 2>/dev/null
+"$rfem" sweep k.toml --jobs 2 -q 2>/dev/null &
+pid=$!
+# Meanwhile: a second sweep on this index is refused at once (exit 2, one line), the first untouched.
+for i in $(seq 1 6000); do [ -e k.h5 ] && break; kill -0 "$pid" 2>/dev/null || break; sleep 0.01; done
+set +e
+"$rfem" sweep k.toml --jobs 2 -q > /dev/null 2> second.err
+code=$?
+wait "$pid"
+first=$?
+set -e
+[ "$code" = 2 ] && [ "$(wc -l < second.err)" = 1 ] && grep -qF "k.h5: another sweep is writing this index" second.err && [ "$first" = 0 ] && [ "$(completed k.h5)" = 4 ] \
+  || { echo "FAIL: two sweeps on one index: second exit $code ($(cat second.err)), first exit $first, $(completed k.h5) of 4 completed"; exit 1; }
+echo "ok   a second sweep on the index: $(cat second.err)"
 /usr/bin/python3 -c "
 import h5py, numpy as np, sys
 ok = np.array_equal(h5py.File('resumed.h5')['quantities'][()], h5py.File('k.h5')['quantities'][()])
@@ -147,26 +195,64 @@ bad() {  # expect, then the file's text
 }
 head='[sweep]
 case = "'"$src"'/cases/kane_spinup.toml"'
+q='quantities = ["peak:u1"]'
 bad "bad.toml:3: sweep.quantity: unknown key" "$head
 quantity = [\"peak:u1\"]
 [parameters]
 n = [4]"
 bad "parameters.n: must be whole numbers" "$head
+$q
 [parameters]
 n = [4.5]"
 bad "has 3 values and 'joints.0.input.T' 2" "$head
+$q
 combine = \"zip\"
 [parameters]
 \"joints.0.input.T\" = [5.0, 6.0]
 n = [4, 8, 16]"
 bad "point 1 (joints.0.input.T=-1): " "$head
+$q
 [parameters]
 \"joints.0.input.T\" = [5, -1]"
 bad "peak:u9" "$head
 quantities = [\"peak:u9\"]
 [parameters]
 n = [4]"
-bad "parameters: missing table" "$head"
+bad "parameters: missing table" "$head
+$q"
+bad "bad.toml:3: sweep.quantities: is empty: name at least one quantity" "$head
+quantities = []
+[parameters]
+n = [4]"
+bad "bad.toml:1: sweep.quantities: missing: name at least one quantity" "$head
+[parameters]
+n = [4]"
+[ ! -e bad.h5.tmp ] && [ ! -e bad.h5 ] || { echo "FAIL: a refused sweep file left $(ls bad.h5*)"; exit 1; }
+# Where the index cannot go (a file for a folder; a read-only folder where the user is not root):
+# one line, exit 2, nothing written. Mid-sweep, an index that cannot be replaced: no .tmp left.
+printf '%s\n' "$head" "$q" '[parameters]' 'n = [4]' > ok.toml
+touch notdir
+mkdir -p ro dir.h5 && chmod a-w ro
+for out in notdir/i.h5 $(touch ro/probe 2>/dev/null || echo ro/i.h5) dir.h5; do
+  set +e
+  "$rfem" sweep ok.toml -q -o "$out" > /dev/null 2> out.err
+  code=$?
+  set -e
+  [ "$code" = 2 ] && [ "$(wc -l < out.err)" = 1 ] && grep -qF "$out" out.err || { echo "FAIL: sweep -o $out: exit $code: $(cat out.err)"; exit 1; }
+  echo "ok   sweep -o $out: $(cat out.err)"
+done
+rm -rf k.h5 k.runs
+"$rfem" sweep k.toml --jobs 1 -q 2> k.err &
+pid=$!
+for i in $(seq 1 6000); do [ -f k.h5 ] && break; kill -0 "$pid" 2>/dev/null || break; sleep 0.01; done
+until rm -f k.h5 && mkdir k.h5 2>/dev/null; do :; done  # (its next rename finds a folder)
+set +e
+wait "$pid"
+code=$?
+set -e
+[ "$code" != 0 ] && grep -qF "k.h5: cannot write the index" k.err && [ ! -e k.h5.tmp ] || { echo "FAIL: an index that cannot be replaced: exit $code, $(ls -d k.h5*): $(cat k.err)"; exit 1; }
+echo "ok   an index that cannot be replaced: exit $code, no k.h5.tmp: $(grep error k.err)"
+rmdir k.h5
 # The index plots: each quantity against each parameter, orders over n.
 "$rfem" plot one.h5 -o figs > /dev/null
 test -s figs/sweep_peak_u1_vs_n.png && test -s figs/sweep_tau1_3_vs_joints.0.input.T.png || { echo "FAIL: sweep figures"; ls figs; exit 1; }
