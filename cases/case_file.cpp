@@ -90,7 +90,7 @@ void apply_override(toml::table& root, const std::string& file, const std::strin
 SimulationSettings read_simulation(const Reader& r, const toml::table& t) {
   const std::string p = "simulation";
   r.check_keys(t, p, {"t_end", "output_dt", "rtol", "atol", "atol_velocity", "max_step", "procedure", "store_flexible_every",
-                      "max_order", "max_steps", "integrator", "method", "initial"});
+                      "max_order", "max_steps", "integrator", "method", "initial", "state"});
   SimulationSettings s;
   IntegratorOptions& o = s.options;
   o.t_end = r.positive(t, p, "t_end");
@@ -127,6 +127,13 @@ SimulationSettings read_simulation(const Reader& r, const toml::table& t) {
   if (initial != "static" && initial != "undeformed")
     r.fail(t.get("initial"), p + ".initial", "must be \"static\" or \"undeformed\" (got \"" + initial + "\")");
   o.initial = initial == "static" ? InitialState::Static : InitialState::Undeformed;
+  s.state = r.string(t, p, "state", std::string());
+  if (t.get("state") && (s.state.empty() || s.state.find('\0') != std::string::npos))
+    r.fail(t.get("state"), p + ".state", "must name a state file (rfem.SimulationState.save)");
+  if (!s.state.empty() && s.procedure != Procedure::Single)
+    r.fail(t.get("state"), p + ".state", "a run from a saved state is one run: procedure = \"single\"");
+  if (!s.state.empty() && o.kind != IntegratorKind::Esdirk)
+    r.fail(t.get("state"), p + ".state", "a run from a saved state integrates with \"esdirk\"");
   try {  // what the integrator itself refuses (the one home of those rules)
     check_options(o);
   } catch (const std::invalid_argument& e) {
@@ -210,6 +217,7 @@ Case parse_case(const std::string& text, const std::string& path, const std::vec
     if (!sn->is_table()) r.fail(sn, "simulation", "must be a table");
     c.sim = read_simulation(r, *sn->as_table());
     c.has_simulation = true;
+    if (!c.sim.state.empty() && c.sim.state[0] != '/' && !case_dir.empty()) c.sim.state = case_dir + "/" + c.sim.state;
     if (c.sim.procedure == Procedure::Paper && c.free_base)
       r.fail(sn->as_table()->get("procedure"), "simulation.procedure",
              "the paper procedure prescribes every joint; a free base has none to prescribe");

@@ -54,6 +54,9 @@ struct SimulationSettings {
   IntegratorOptions options;
   Procedure procedure = Procedure::Single;  ///< single, or paper (rigid inverse dynamics, kinematic, force input)
   int flexible_every = 0;            ///< store the full flexible state every k outputs (0: never)
+  /// Start from a saved simulation state (studies/simulation.hpp: save_state), resolved against the
+  /// case's folder; "" for the case's own initial state.
+  std::string state;
 };
 
 /// A flexible link of a case: [link] (the only one) or an element of [[links]].

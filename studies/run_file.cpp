@@ -4,12 +4,48 @@
 #include "rfem/studies/common.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/recorders.hpp"
+#include "rfem/studies/simulation.hpp"
 
 namespace rfem {
+
+FileRuns run_from_state(const Case& cs, const RunRequest& rq, const std::string& output, const std::string& made_by) {
+  check_runnable(cs);
+  SimulationOptions o;
+  o.n = rq.n;
+  o.threads = rq.threads;
+  o.output = output;
+  o.made_by = made_by;
+  o.keep_series = rq.keep_series;
+  o.observers = rq.observers;
+  o.warn = rq.warn;
+  o.stop = rq.stop;
+  if (rq.progress)
+    o.heartbeat = [&rq, &cs](double t, long steps) { rq.progress({"run", t, cs.sim.options.t_end, steps}); };
+  try {
+    o.state = std::make_shared<const SimulationState>(load_state(cs.sim.state));
+  } catch (const ResultsError& e) {
+    throw CaseError(cs.path + ": simulation.state: " + e.what());
+  } catch (const std::invalid_argument& e) {
+    throw CaseError(cs.path + ": simulation.state: " + e.what());
+  }
+  std::unique_ptr<Simulation> sim;
+  try {
+    sim = std::make_unique<Simulation>(cs, std::move(o));
+  } catch (const std::invalid_argument& e) {  // another model's state
+    throw CaseError(cs.path + ": simulation.state: " + cs.sim.state + ": " + e.what());
+  }
+  FileRuns out;
+  out.model = sim->shared_model();
+  sim->advance(sim->t_end());
+  out.runs.push_back(sim->finish());
+  if (!output.empty()) out.views = write_views(cs, *out.model, output, rq.warn);
+  return out;
+}
 
 FileRuns run_into_file(const Case& cs, RunRequest rq, const std::string& output, const std::string& made_by,
                        const std::function<void(const std::shared_ptr<const Model>&, const std::vector<JointInput>&)>& ready) {
   check_runnable(cs);
+  if (!cs.sim.state.empty()) return run_from_state(cs, rq, output, made_by);
   FileRuns out;
   out.model = model_of(cs, rq.n);
   const std::vector<JointInput> inputs = joint_inputs(cs, rq.warn);

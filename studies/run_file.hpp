@@ -25,6 +25,12 @@ struct FileRuns {
 /// observers see them, the file closed and ParaView's views written beside it (warnings through
 /// rq.warn). `made_by` is the command line or call kept in the file. Every row a run computed is in
 /// the file whatever its status.
+/// A case whose [simulation] starts from a saved state (`state`): its one run as a stepped
+/// simulation from that state (studies/simulation.hpp), into `output` if not "", with rq's n,
+/// threads, observers, series, warnings and stop token. CaseError naming simulation.state for a
+/// file that is not a state, or the state of another model.
+FileRuns run_from_state(const Case& cs, const RunRequest& rq, const std::string& output, const std::string& made_by);
+
 FileRuns run_into_file(const Case& cs, RunRequest rq, const std::string& output, const std::string& made_by,
                        const std::function<void(const std::shared_ptr<const Model>&, const std::vector<JointInput>&)>& ready = {});
 

@@ -9,6 +9,7 @@
 #include "rfem/core/positions.hpp"
 #include "rfem/studies/checkpoints.hpp"
 #include "rfem/studies/inputs.hpp"
+#include "rfem/studies/run_file.hpp"
 #include "rfem/studies/sensors.hpp"
 #include "rfem/studies/validity.hpp"
 
@@ -212,6 +213,7 @@ void check_runnable(const Case& cs) {
 
 std::vector<RunResult> run_case(const Case& cs, const RunRequest& rq) {
   check_runnable(cs);
+  if (!cs.sim.state.empty()) return run_from_state(cs, rq, "", "").runs;
   const auto model = model_of(cs, rq.n);
   return run_case(cs, model, joint_inputs(cs, rq.warn), rq);
 }
@@ -220,6 +222,8 @@ std::vector<RunResult> run_case(const Case& cs, std::shared_ptr<const Model> mod
                                 const RunRequest& rq) {
   if (!model) throw std::invalid_argument("run_case: no model");
   check_runnable(cs);
+  if (!cs.sim.state.empty())
+    throw CaseError(cs.path + ": simulation.state: a run from a saved state builds its own model (run_case(case, request))");
   if (static_cast<int>(inputs.size()) != model->m())
     throw std::invalid_argument("run_case: one input per joint is required (" + std::to_string(model->m()) + ")");
   const std::vector<RunName> all = runs_of(cs.sim.procedure);

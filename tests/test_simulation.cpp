@@ -369,3 +369,31 @@ TEST(Simulation, TheBuiltInDigitalPdIsTheSameLawAsAControllerBitForBit) {
   EXPECT_NE(series(late, "joint_q").data, series(builtin, "joint_q").data);
   EXPECT_THROW(run_case(with_overrides(digital, {"simulation.integrator=\"bdf\""}), rq), CaseError);
 }
+
+TEST(Simulation, ACaseStartsFromASavedStateAsTheProgramRunsIt) {
+  // [simulation] state = "FILE": rfem run (run_case, run_into_file) goes on from the saved state,
+  // the same bits as the simulation it was saved from; another model's state is refused by key.
+  const Case cs = hub(0.3);
+  Simulation first(cs, one_thread());
+  first.advance(0.12);
+  const std::string path = (std::filesystem::temp_directory_path() / "rfem_test_case_state.h5").string();
+  save_state(first.state(), path);
+  first.advance(0.3);
+  RunRequest rq;
+  rq.threads = 1;
+  const Case from = with_overrides(cs, {"simulation.state=\"" + path + "\""});
+  const RunResult r = run_case(from, rq).at(0);
+  ASSERT_TRUE(r.completed()) << r.status;
+  const Table q = series(r, "joint_q");
+  EXPECT_EQ(series(r, "time").at(0, 0), 0.12);
+  EXPECT_EQ(q.at(q.rows - 1, 0), first.q()[first.model().joint_index(0)]);
+  try {
+    run_case(with_overrides(from, {"link.n=7"}), rq);
+    ADD_FAILURE() << "another model's state was accepted";
+  } catch (const CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("simulation.state"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("another model"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(run_case(with_overrides(cs, {"simulation.state=\"/no/such/state.h5\""}), rq), CaseError);
+  std::filesystem::remove(path);
+}
