@@ -11,6 +11,7 @@
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/recorders.hpp"
 #include "rfem/studies/refine.hpp"
+#include "rfem/studies/run_file.hpp"
 
 namespace rfem::app {
 
@@ -45,24 +46,18 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
   // Every quantity and every n are checked before the first run (and before the file is made).
   const std::vector<Quantity> qs = check_refinement(cs, rq);
   const bool dynamic = std::any_of(qs.begin(), qs.end(), [](const Quantity& q) { return q.dynamic(); });
-  std::unique_ptr<ResultsWriter> file;
+  std::string path;  // (a study with runs keeps them in a file, by default beside the case's name)
   if (dynamic || !ro.output.empty()) {
-    std::string path = ro.output;
+    path = ro.output;
     if (path.empty()) {
       const std::string stem = cs.path.substr(cs.path.find_last_of('/') + 1);
       path = stem.substr(0, stem.rfind('.')) + "_refine.h5";
     }
-    file = std::make_unique<ResultsWriter>(create_results(path, describe(cs, c.command_line, "refine", -1, max_threads(c))));
   }
   const bool quiet = c.json || c.quiet;
   if (dynamic) check_run_cost(cs, model_of(cs, ro.ns.back()), joint_inputs(cs), c);
   const SignalStop signals(rq.stop);
   ProgressLine progress(quiet);
-  std::unique_ptr<Hdf5Recorder> recorder;
-  if (file) {
-    recorder = std::make_unique<Hdf5Recorder>(*file);
-    rq.observers.push_back(recorder.get());
-  }
   rq.progress = [&](const Progress& p) { progress.show(p); };
   rq.on_n = [&](int i, int count, int n) {
     progress.clear();
@@ -70,12 +65,8 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
     if (i < count) fmt::print(stderr, "[{}/{}] n = {}\n", i + 1, count, n);
     else fmt::print(stderr, "[check] n = {} at rtol {:g}\n", n, cs.sim.options.rtol / 100);
   };
-  const RefineResult res = refine(cs, rq);
+  const RefineResult res = path.empty() ? refine(cs, rq) : refine_into_file(cs, rq, path, c.command_line);
   progress.clear();
-  if (file) {
-    file->write_refinement(ro.quantities, res.ns, res.tables, res.status);
-    file->close();
-  }
   for (size_t k = 0; k < qs.size(); ++k)  // warnings always reach stderr, with --json and --quiet too
     for (const auto& w : res.tables[k].warnings) print_warning(qs[k].text + ": " + w);
   const int code = res.status.kind == RunStatus::Kind::Interrupted ? 128 + std::max(res.status.signal, 2) : 0;
@@ -91,12 +82,12 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
                     {"integration_error", num(res.tables[k].integration_error)}, {"warnings", res.tables[k].warnings}});
     }
     print_json({{"command", "refine"}, {"case", cs.path}, {"status", res.status.to_string()}, {"quantities", jq},
-                {"output", file ? file->path() : ""}});
+                {"output", path}});
     return code;
   }
   print_tables(cs, res);
-  if (file)
-    fmt::print("every run and the table in {}{}\n", file->path(),
+  if (!path.empty())
+    fmt::print("every run and the table in {}{}\n", path,
                res.status.is_completed() ? "" : " (" + res.status.to_string() + ")");
   return code;
 }

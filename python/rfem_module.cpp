@@ -478,22 +478,9 @@ PYBIND11_MODULE(_rfem, m) {
     rq.warn = [&warnings](const std::string& w) { warnings.push_back(w); };
     RefineResult res;
     {
+      const std::string made_by = output.empty() ? "" : python_made_by("rfem.refine");
       py::gil_scoped_release release;
-      const std::vector<Quantity> qs = check_refinement(cs, rq);
-      std::unique_ptr<ResultsWriter> file;
-      std::unique_ptr<Hdf5Recorder> recorder;
-      if (!output.empty()) {
-        Parallelism p;
-        p.threads = rq.threads;
-        file = std::make_unique<ResultsWriter>(output, python_description(cs, "rfem.refine", "refine", -1, p.max_threads()));
-        recorder = std::make_unique<Hdf5Recorder>(*file);
-        rq.observers.push_back(recorder.get());
-      }
-      res = refine(cs, rq);
-      if (file) {
-        file->write_refinement(quantities, res.ns, res.tables, res.status);
-        file->close();
-      }
+      res = output.empty() ? refine(cs, rq) : refine_into_file(cs, rq, output, made_by);
     }
     py::dict out;
     out["status"] = res.status.to_string();

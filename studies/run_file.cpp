@@ -42,6 +42,19 @@ FileRuns run_from_state(const Case& cs, const RunRequest& rq, const std::string&
   return out;
 }
 
+RefineResult refine_into_file(const Case& cs, RefineRequest rq, const std::string& output, const std::string& made_by) {
+  check_refinement(cs, rq);  // (before the file exists)
+  Parallelism p;
+  p.threads = rq.threads;
+  ResultsWriter file(output, describe(cs, made_by, "refine", -1, p.max_threads()));
+  Hdf5Recorder recorder(file);
+  rq.observers.insert(rq.observers.begin(), &recorder);
+  const RefineResult res = refine(cs, rq);
+  file.write_refinement(rq.quantities, res.ns, res.tables, res.status);
+  file.close();
+  return res;
+}
+
 FileRuns run_into_file(const Case& cs, RunRequest rq, const std::string& output, const std::string& made_by,
                        const std::function<void(const std::shared_ptr<const Model>&, const std::vector<JointInput>&)>& ready) {
   check_runnable(cs);

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "rfem/studies/refine.hpp"
 #include "rfem/studies/runs.hpp"
 
 namespace rfem {
@@ -33,5 +34,11 @@ FileRuns run_from_state(const Case& cs, const RunRequest& rq, const std::string&
 
 FileRuns run_into_file(const Case& cs, RunRequest rq, const std::string& output, const std::string& made_by,
                        const std::function<void(const std::shared_ptr<const Model>&, const std::vector<JointInput>&)>& ready = {});
+
+/// A refinement study into a new results file: every quantity and n checked first (CaseError),
+/// the file created (ResultsError), every run recorded into it as it goes (groups "n12/run", …),
+/// then the `refine` group with the tables, and the file closed. The rows of a study that stops
+/// are kept.
+RefineResult refine_into_file(const Case& cs, RefineRequest rq, const std::string& output, const std::string& made_by);
 
 }  // namespace rfem

@@ -26,6 +26,7 @@
 #include "rfem/studies/quantities.hpp"
 #include "rfem/studies/recorders.hpp"
 #include "rfem/studies/resume.hpp"
+#include "rfem/studies/run_file.hpp"
 #include "rfem/studies/runs.hpp"
 
 namespace rfem {
@@ -254,13 +255,8 @@ SweepRow run_point(const Sweep& s, int k, const StopToken& stop, int threads, co
         row.residual_evals += static_cast<long>(in.number(r, "residual_evals", 0.0));
       }
     } else {
-      const auto model = model_of(c, n);
-      ResultsWriter file(p.file, describe(c, "rfem sweep " + s.path + " (" + point_name(s, k) + ")",
-                                          to_string(c.sim.procedure), model->n(), threads, n));
-      Hdf5Recorder recorder(file);
-      rq.observers = {&recorder, &values};
-      runs = run_case(c, model, joint_inputs(c, warn), rq);
-      file.close();
+      rq.observers = {&values};  // (after the file's recorder: studies/run_file.hpp)
+      runs = run_into_file(c, rq, p.file, "rfem sweep " + s.path + " (" + point_name(s, k) + ")").runs;
     }
     row.status = RunStatus::completed();
     for (const RunResult& r : runs) {
