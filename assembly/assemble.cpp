@@ -17,6 +17,21 @@ int Parallelism::team(int n) const {
 
 int Parallelism::max_threads() const { return threads > 0 ? threads : omp_get_max_threads(); }
 
+void Workspace::bind(const Model& model) {
+  bound_rfes_ = model.n();
+  bound_joints_ = model.m();
+  bound_links_ = static_cast<int>(model.links.size());
+  chunks(model);
+}
+
+void Workspace::check(const Model& model) const {
+  if (bound_rfes_ < 0) return;
+  RFEM_CHECK_ARGUMENT(bound_rfes_ == model.n() && bound_joints_ == model.m() && bound_links_ == static_cast<int>(model.links.size()),
+                      "the workspace was built for a model of " + std::to_string(bound_rfes_) + " rfes and " +
+                          std::to_string(bound_joints_) + " joints, not this one's " + std::to_string(model.n()) + " and " +
+                          std::to_string(model.m()));
+}
+
 int Workspace::chunks(const Model& model) {
   chunk.clear();
   for (size_t l = 0; l < model.links.size(); ++l) {
@@ -87,6 +102,7 @@ void generalised_forces(const Model& model, const VecX& q, const VecX& v, const 
   RFEM_CHECK_ARGUMENT_SIZE(a.size(), model.dof(), "a");
   Workspace local;
   Workspace& ws = wsp ? *wsp : local;
+  ws.check(model);
   const double g = terms.gravity ? model.gravity : 0.0;
   F.resize(model.dof());
   F.tail(model.dof() - model.chain_dofs()).setZero();  // carrying rfes and joints: sums below
@@ -229,6 +245,7 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
   }
   Workspace local;
   Workspace& ws = wsp ? *wsp : local;
+  ws.check(model);
   const int N = static_cast<int>(model.nodes.size()), m = model.m(), nb = pattern.n_base(),
             ne = static_cast<int>(extra.size()), n6 = model.chain_dofs();
   // Each chain block's values are zeroed by the chunk that writes them (in cache, on its thread);
@@ -412,6 +429,7 @@ Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* w
   RFEM_CHECK_ARGUMENT_SIZE(v.size(), model.dof(), "v");
   Workspace local;
   Workspace& ws = wsp ? *wsp : local;
+  ws.check(model);
   Energies E;
   if (ws.zero.size() != model.dof()) ws.zero = VecX::Zero(model.dof());
   BaseKinematics& bk = ws.bk;

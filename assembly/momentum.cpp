@@ -18,6 +18,7 @@ Momentum momentum(const Model& model, const VecX& q, const VecX& v, Workspace* w
   RFEM_CHECK_ARGUMENT_SIZE(v.size(), model.dof(), "v");
   Workspace local;
   Workspace& ws = wsp ? *wsp : local;
+  ws.check(model);
   if (ws.zero.size() != model.dof()) ws.zero = VecX::Zero(model.dof());
   BaseKinematics& bk = ws.bk;
   base_kinematics(model, q, v, ws.zero, bk);

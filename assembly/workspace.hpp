@@ -41,8 +41,15 @@ struct BaseMoments {
 };
 
 struct Workspace {
+  /// Unbound: adapts to whatever model it is given (tests, one-off calls).
   Workspace() = default;
   explicit Workspace(const Parallelism& p) : parallel(p) {}
+  /// Bound to `model` (its chunks cut once): every kernel it is passed to checks that it gets that
+  /// model's shape — the hot paths (the equations, statics, the rigid torques) use one of these.
+  explicit Workspace(const Model& model, const Parallelism& p = {}) : parallel(p) { bind(model); }
+  void bind(const Model& model);
+  /// std::invalid_argument unless unbound or bound to a model of this shape (rfes, joints, links).
+  void check(const Model& model) const;
   Parallelism parallel;
   BaseKinematics bk;
   /// A chunk: rfes begin … end − 1 of one link (chunks never span two links).
@@ -59,6 +66,9 @@ struct Workspace {
   /// Cuts every link of the model into chunks, sizes the chunk arrays (cleared) and returns the
   /// number of chunks.
   int chunks(const Model& model);
+
+ private:
+  int bound_rfes_ = -1, bound_joints_ = -1, bound_links_ = -1;  // −1: unbound
 };
 
 }  // namespace rfem

@@ -37,6 +37,7 @@ EquationsOfMotion::EquationsOfMotion(std::shared_ptr<const Model> model_ptr, std
   const std::vector<JointInput>& inputs = inputs_;
   ws_.parallel = parallel;
   ws_.parallel.threads = governor_.threads();
+  ws_.bind(model);  // (checked against the model at every kernel call)
   RFEM_CHECK_ARGUMENT_SIZE(inputs.size(), model.m(), "inputs (one per joint)");
   for (int j = 0; j < model.m(); ++j)
     RFEM_CHECK_ARGUMENT(inputs[j].motion || inputs[j].torque,

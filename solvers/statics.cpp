@@ -69,16 +69,16 @@ VecX tip_load_forces(const Model& model, const VecX& q, const TipLoads& loads) {
 namespace {
 
 // Residual of the flexible rows at load factor lam: internal + gravity + centrifugal − tip loads.
-VecX residual(const Model& model, const VecX& q, const VecX& v, const TipLoads& loads, double lam) {
+VecX residual(const Model& model, const VecX& q, const VecX& v, const TipLoads& loads, double lam, Workspace& ws) {
   VecX F;
   const VecX a = VecX::Zero(model.dof());
   ForceTerms terms;
-  generalised_forces(model, q, v, a, terms, F);
+  generalised_forces(model, q, v, a, terms, F, nullptr, &ws);
   // Gravity and centrifugal forces are loads here: scale them by lam like the tip loads.
   ForceTerms load_terms;
   load_terms.sde = false;
   VecX L;
-  generalised_forces(model, q, v, a, load_terms, L);
+  generalised_forces(model, q, v, a, load_terms, L, nullptr, &ws);
   VecX r = F.head(model.flexible_dofs()) - (1.0 - lam) * L.head(model.flexible_dofs());
   r -= lam * tip_load_forces(model, q, loads).head(model.flexible_dofs());
   return r;
@@ -107,23 +107,24 @@ StaticResult solve_static(const Model& model, const VecX& qb, const VecX& vb, co
   terms.gravity = true;
   terms.inertial = vb.size() > 0 && vb.norm() > 0.0;
   std::vector<double> values;
+  Workspace ws(model);  // the Newton iteration's scratch, cut once
 
   // Load scale for the convergence test: the full load vector at the undeformed state.
-  const double scale = std::max(residual(model, res.q, v, loads, 1.0).norm(), 1e-12);
+  const double scale = std::max(residual(model, res.q, v, loads, 1.0, ws).norm(), 1e-12);
   double lam = 0.0, step = 1.0;
   while (lam < 1.0) {
     const double target = std::min(1.0, lam + step);
     VecX q = res.q;
     bool ok = false;
     for (int it = 0; it < opts.max_iterations; ++it) {
-      const VecX r = residual(model, q, v, loads, target);
+      const VecX r = residual(model, q, v, loads, target, ws);
       res.residual = r.norm();
       if (!std::isfinite(res.residual)) break;
       if (res.residual <= opts.tolerance * scale) {
         ok = true;
         break;
       }
-      assemble_matrix(model, pattern, held, q, v, terms, values);
+      assemble_matrix(model, pattern, held, q, v, terms, values, &ws);
       if (!solver.factorize(values)) break;
       VecX dq = -r;
       solver.solve(dq);
@@ -132,7 +133,7 @@ StaticResult solve_static(const Model& model, const VecX& qb, const VecX& vb, co
       // Converged when the correction is at round-off of the coordinates (the residual itself
       // cannot drop below round-off of the stiff axial springs, c Δx ~ 1e8 N/m × 1e-15 m).
       if (dq.lpNorm<Eigen::Infinity>() <= opts.step_tolerance * (1.0 + q.head(model.flexible_dofs()).lpNorm<Eigen::Infinity>())) {
-        res.residual = residual(model, q, v, loads, target).norm();
+        res.residual = residual(model, q, v, loads, target, ws).norm();
         ok = std::isfinite(res.residual);
         break;
       }

@@ -163,6 +163,14 @@ TEST(Library, SolversRefuseWrongSizesAndMissingBuffers) {
   ASSERT_TRUE(eq.setup_newton(0.0, qu.data(), vu.data(), 1e-3));
   EXPECT_THROW(eq.solve_newton_bdf(nullptr, x2.data()), std::invalid_argument);
   EXPECT_NO_THROW(eq.solve_newton_bdf(b2.data(), x2.data()));
+  // A workspace built for one model refuses another (the chunks would index past its links).
+  Workspace bound(m);
+  const Model other = test::spatial_arm(6);
+  const VecX qo = VecX::Zero(other.dof());
+  VecX F;
+  EXPECT_THROW(generalised_forces(other, qo, qo, qo, ForceTerms{}, F, nullptr, &bound), std::invalid_argument);
+  EXPECT_THROW(energies(other, qo, qo, &bound), std::invalid_argument);
+  EXPECT_NO_THROW(generalised_forces(m, q, q, q, ForceTerms{}, F, nullptr, &bound));
 }
 
 TEST(Library, RunStatusSurvivesItsText) {
