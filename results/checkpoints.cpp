@@ -4,6 +4,7 @@
 // group (SWMR allows no new objects while the run goes). A checkpoint is written into the older slot
 // after the rows it covers are flushed, then flushed itself: a run killed at any moment leaves at
 // least one intact slot (its checksum agrees) whose rows are all in the file.
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 
@@ -13,20 +14,57 @@ namespace rfem {
 
 namespace {
 
-// Slot header: magic, sequence, rows, flexible rows, state length, checksum (two 32-bit halves).
-constexpr double kMagic = 20261203.0;
-constexpr int kHeader = 7;
+// Slot header: magic, sequence, rows, flexible rows, state length, the case's checksum and the
+// slot's checksum (each two 32-bit halves: exact as doubles). Slots of rfem before the case's
+// checksum (kOldMagic) have no case checksum and still resume.
+constexpr double kMagic = 20261204.0, kOldMagic = 20261203.0;
+constexpr int kHeader = 9, kOldHeader = 7;
 
-// FNV-1a over the header's first five values and the state, as bytes.
-uint64_t checksum(const double* header, const double* state, size_t n) {
-  uint64_t h = 1469598103934665603ull;
-  auto eat = [&](const double* p, size_t count) {
-    const auto* b = reinterpret_cast<const unsigned char*>(p);
-    for (size_t i = 0; i < count * sizeof(double); ++i) h = (h ^ b[i]) * 1099511628211ull;
-  };
-  eat(header, 5);
-  eat(state, n);
+uint64_t fnv(uint64_t h, const unsigned char* b, size_t bytes) {
+  for (size_t i = 0; i < bytes; ++i) h = (h ^ b[i]) * 1099511628211ull;
   return h;
+}
+constexpr uint64_t kFnvStart = 1469598103934665603ull;
+
+// FNV-1a over the header's values before the slot checksum (`head` of them) and the state, as bytes.
+uint64_t checksum(const double* header, int head, const double* state, size_t n) {
+  const uint64_t h = fnv(kFnvStart, reinterpret_cast<const unsigned char*>(header), head * sizeof(double));
+  return fnv(h, reinterpret_cast<const unsigned char*>(state), n * sizeof(double));
+}
+
+double hi(uint64_t v) { return static_cast<double>(v >> 32); }
+double lo(uint64_t v) { return static_cast<double>(v & 0xffffffffull); }
+
+}  // namespace
+
+uint64_t writer_detail::case_checksum(const std::string& case_text, const std::string& overrides, long n_option) {
+  uint64_t h = kFnvStart;
+  for (const std::string& part : {case_text, overrides, std::to_string(n_option)}) {
+    h = fnv(h, reinterpret_cast<const unsigned char*>(part.data()), part.size());
+    h = fnv(h, reinterpret_cast<const unsigned char*>("\0"), 1);  // (parts end: "ab"+"c" is not "a"+"bc")
+  }
+  return h;
+}
+
+uint64_t writer_detail::case_checksum(hid_t file, const std::string& what) {
+  std::string text, overrides;
+  h5::read_string_attribute(file, "case_text", text);
+  h5::read_string_attribute(file, "overrides", overrides);
+  long n = -1;
+  if (H5Aexists(file, "n_option") > 0) {
+    const h5::Handle a = h5::attribute(H5Aopen(file, "n_option", H5P_DEFAULT), what);
+    h5::check(H5Aread(a, H5T_NATIVE_LONG, &n), what);
+  }
+  return case_checksum(text, overrides, n);
+}
+
+namespace {
+// A slot is written whole, but HDF5 reads the chunks a row only partly fills first: without checking
+// their Fletcher-32 sums, so a damaged (torn) slot can be written over.
+h5::Handle overwrite_list(const std::string& what) {
+  h5::Handle dxpl = h5::plist(H5Pcreate(H5P_DATASET_XFER), what);
+  h5::check(H5Pset_edc_check(dxpl, H5Z_DISABLE_EDC), what);
+  return dxpl;
 }
 
 }  // namespace
@@ -37,10 +75,11 @@ void RunWriter::Impl::create_checkpoints() {
   const h5::Handle space = h5::space(H5Screate_simple(2, dims, maxd), w);
   const h5::Handle plist = h5::plist(H5Pcreate(H5P_DATASET_CREATE), w);
   h5::check(H5Pset_chunk(plist, 2, chunk), w);
+  h5::checksummed(plist, w);
   checkpoints = h5::dataset(H5Dcreate2(group, "checkpoint", H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, plist, H5P_DEFAULT), w);
   h5::write_attribute(checkpoints, "description",
                       std::string("the run's state to resume from (rfem run --resume): two slots written in turn, "
-                                  "each [magic, sequence, rows, flexible rows, length, checksum, checksum, state…]"));
+                                  "each [magic, sequence, rows, flexible rows, length, case checksum (2), checksum (2), state…]"));
 }
 
 void RunWriter::checkpoint(const std::vector<double>& state) {
@@ -54,9 +93,11 @@ void RunWriter::checkpoint(const std::vector<double>& state) {
   slot[2] = static_cast<double>(w.rows);
   slot[3] = static_cast<double>(w.flex_rows);
   slot[4] = static_cast<double>(state.size());
-  const uint64_t sum = checksum(slot.data(), state.data(), state.size());
-  slot[5] = static_cast<double>(sum >> 32);
-  slot[6] = static_cast<double>(sum & 0xffffffffull);
+  slot[5] = hi(w.file->case_sum);
+  slot[6] = lo(w.file->case_sum);
+  const uint64_t sum = checksum(slot.data(), 7, state.data(), state.size());
+  slot[7] = hi(sum);
+  slot[8] = lo(sum);
   std::copy(state.begin(), state.end(), slot.begin() + kHeader);
   w.file->require(kMargin + w.unflushed + 2 * static_cast<long long>(slot.size() * sizeof(double)));
   w.flush();  // the rows first: the checkpoint may only cover rows that are in the file
@@ -71,7 +112,7 @@ void RunWriter::checkpoint(const std::vector<double>& state) {
   const hsize_t start[2] = {static_cast<hsize_t>(w.checkpoint_sequence % 2), 0}, count[2] = {1, slot.size()};
   h5::check(H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start, nullptr, count, nullptr), what);
   const h5::Handle mspace = h5::space(H5Screate_simple(2, count, nullptr), what);
-  h5::check(H5Dwrite(w.checkpoints, H5T_NATIVE_DOUBLE, mspace, fspace, H5P_DEFAULT, slot.data()), what);
+  h5::check(H5Dwrite(w.checkpoints, H5T_NATIVE_DOUBLE, mspace, fspace, overwrite_list(what), slot.data()), what);
   if (w.file->swmr) h5::check(H5Dflush(w.checkpoints), what);
   w.file->flush();
 }
@@ -79,24 +120,45 @@ void RunWriter::checkpoint(const std::vector<double>& state) {
 std::optional<Checkpoint> read_checkpoint(const ResultsReader& in, const std::string& run) {
   const std::string object = run + "/checkpoint";
   if (!in.has(object)) return std::nullopt;
-  const Table t = in.table(object);
+  const long slots = in.shape(object).first;
+  const uint64_t case_sum = writer_detail::case_checksum(in.attribute("/", "case_text"), in.attribute("/", "overrides"),
+                                                         static_cast<long>(in.number("/", "n_option", -1)));
+  const std::string where = in.path() + ": " + run + ": ";
   std::optional<Checkpoint> best;
-  for (long r = 0; r < t.rows; ++r) {
-    if (t.cols < kHeader) break;
-    const double* slot = t.data.data() + r * t.cols;
+  bool written = false;
+  for (long r = 0; r < slots; ++r) {
+    Table t;
+    try {
+      t = in.rows(object, r, 1);  // a slot by itself: a damaged one (its Fletcher-32 checksum) leaves the other
+    } catch (const ResultsError&) {
+      written = true;
+      continue;
+    }
+    const double* slot = t.data.data();
+    if (std::any_of(slot, slot + t.cols, [](double x) { return x != 0; })) written = true;
+    const bool old = t.cols >= kOldHeader && slot[0] == kOldMagic;
+    const int header = old ? kOldHeader : kHeader;
+    if (t.cols < header || (slot[0] != kMagic && !old)) continue;
     const double length = slot[4];
-    if (slot[0] != kMagic || !(length >= 0 && length <= t.cols - kHeader)) continue;
+    if (!(length >= 0 && length <= t.cols - header)) continue;
     const size_t n = static_cast<size_t>(length);
-    const uint64_t sum = checksum(slot, slot + kHeader, n);
-    if (slot[5] != static_cast<double>(sum >> 32) || slot[6] != static_cast<double>(sum & 0xffffffffull)) continue;
+    const uint64_t sum = checksum(slot, header - 2, slot + header, n);
+    if (slot[header - 2] != hi(sum) || slot[header - 1] != lo(sum)) continue;
+    if (!old && (slot[5] != hi(case_sum) || slot[6] != lo(case_sum)))
+      throw ResultsError(where + "its checkpoint is of another case, other --set values or another n than the file's "
+                                 "rows: not resumed (run the case again)");
     Checkpoint c;
     c.sequence = static_cast<long>(slot[1]);
     c.rows = static_cast<long>(slot[2]);
     c.flexible_rows = static_cast<long>(slot[3]);
     if (best && best->sequence > c.sequence) continue;
-    c.state.assign(slot + kHeader, slot + kHeader + n);
+    c.state.assign(slot + header, slot + header + n);
     best = std::move(c);
   }
+  // A run killed before its first checkpoint starts again; one whose checkpoints are all damaged
+  // would lose its rows that way: refused.
+  if (!best && written)
+    throw ResultsError(where + "no intact checkpoint (damaged, or not this file's): not resumed (run the case again)");
   return best;
 }
 
@@ -138,6 +200,19 @@ std::unique_ptr<RunWriter> ResultsWriter::resume_run(const std::string& name, st
   w.status = h5::dataset(H5Dopen2(w.group, "status_now", H5P_DEFAULT), w.what("reopening the status of"));
   w.checkpoints = h5::dataset(H5Dopen2(w.group, "checkpoint", H5P_DEFAULT), w.what("reopening the checkpoints of"));
   w.checkpoint_sequence = from.sequence;
+  {  // The other slot is older, or newer and damaged (it was not chosen): cleared, so the file reads whole.
+    const std::string what = w.what("clearing the unused checkpoint of");
+    const h5::Handle fspace = h5::space(H5Dget_space(w.checkpoints), what);
+    hsize_t dims[2] = {0, 0};
+    h5::check(H5Sget_simple_extent_dims(fspace, dims, nullptr), what);
+    if (dims[0] == 2 && dims[1] > 0) {
+      const std::vector<double> zero(dims[1], 0.0);
+      const hsize_t start[2] = {static_cast<hsize_t>((from.sequence + 1) % 2), 0}, count[2] = {1, dims[1]};
+      h5::check(H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start, nullptr, count, nullptr), what);
+      const h5::Handle mspace = h5::space(H5Screate_simple(2, count, nullptr), what);
+      h5::check(H5Dwrite(w.checkpoints, H5T_NATIVE_DOUBLE, mspace, fspace, overwrite_list(what), zero.data()), what);
+    }
+  }
   h5::write_attribute(w.group, "status", std::string("running"));
   w.set_status("running");
   writer_detail::queue_run_description(f, name, d);

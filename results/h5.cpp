@@ -139,4 +139,20 @@ bool read_string_attribute(hid_t obj, const std::string& key, std::string& value
   return true;
 }
 
+Handle checked_layout(int rank, const hsize_t* dims, const std::string& what) {
+  Handle plist = h5::plist(H5Pcreate(H5P_DATASET_CREATE), what);
+  std::vector<hsize_t> chunk(dims, dims + rank);
+  hsize_t values = 1;
+  for (hsize_t& c : chunk) {
+    if (c == 0) return plist;
+    if (&c != &chunk.front()) values *= c;
+  }
+  if (rank > 0) chunk[0] = std::max<hsize_t>(1, std::min<hsize_t>(chunk[0], (hsize_t{1} << 16) / std::max<hsize_t>(1, values)));
+  check(H5Pset_chunk(plist, rank, chunk.data()), what);
+  checksummed(plist, what);
+  return plist;
+}
+
+void checksummed(hid_t dcpl, const std::string& what) { check(H5Pset_fletcher32(dcpl), what); }
+
 }  // namespace rfem::h5

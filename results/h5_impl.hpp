@@ -74,6 +74,13 @@ Handle plist(hid_t id, const std::string& what);
 Handle attribute(hid_t id, const std::string& what);
 Handle object(hid_t id, const std::string& what);
 
+/// A dataset-creation list for a fixed-size table of `dims`: chunked (the whole table one chunk, at
+/// most 64k values a chunk) with HDF5's Fletcher-32 checksum, so damaged values fail on read. An
+/// empty table (nothing to check, and HDF5 chunks no zero extent) gets the default list.
+Handle checked_layout(int rank, const hsize_t* dims, const std::string& what);
+/// Adds the Fletcher-32 checksum filter to a dataset-creation list (chunked: every filter needs chunks).
+void checksummed(hid_t dcpl, const std::string& what);
+
 /// Variable-length UTF-8 strings: h5py reads them as str.
 Handle string_type();
 /// Attributes (replacing one of the same name), strings as variable-length UTF-8.

@@ -10,6 +10,10 @@ std::vector<double> Table::column(long c) const {
   return out;
 }
 
+namespace {
+constexpr unsigned kSwmrReadAttempts = 20;
+}  // namespace
+
 struct ResultsReader::Impl {
   std::string path;
   h5::Handle file;
@@ -19,9 +23,16 @@ ResultsReader::ResultsReader(const std::string& path) : impl_(std::make_unique<I
   const h5::Quiet quiet;
   impl_->path = path;
   const h5::Handle fapl = h5::plist(H5Pcreate(H5P_FILE_ACCESS), path);
-  // A file being written (SWMR) is read with SWMR too; a finished one opens either way.
-  hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, fapl);
-  if (id < 0) id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl);
+  // A finished file opens without SWMR: damage is then an error at once. Only a file marked as
+  // written (a run writing it, or killed while it did) needs SWMR read, whose checksum failures
+  // HDF5 retries with doubling sleeps (100 tries by default: hours): a few tries (about 1 ms of
+  // sleep) outlast a writer's flush, and a damaged file fails.
+  hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl);
+  if (id < 0) {
+    h5::reason();
+    h5::check(H5Pset_metadata_read_attempts(fapl, kSwmrReadAttempts), path + ": file access list");
+    id = H5Fopen(path.c_str(), H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, fapl);
+  }
   impl_->file = h5::file(id, path + ": not a readable HDF5 results file");
 }
 
@@ -103,6 +114,28 @@ Table ResultsReader::table(const std::string& object) const {
   out.cols = static_cast<long>(dims[1]);
   out.data.resize(dims[0] * dims[1]);
   if (!out.data.empty()) h5::check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data.data()), what);
+  return out;
+}
+
+Table ResultsReader::rows(const std::string& object, long first, long count) const {
+  const h5::Quiet quiet;
+  const std::string what = impl_->path + ": " + object;
+  if (!has(object)) throw ResultsError(what + ": no such dataset");
+  hsize_t dims[2] = {0, 0};
+  const h5::Handle d = open_table(impl_->file, object, what, dims);
+  if (first < 0 || count < 0 || static_cast<hsize_t>(first + count) > dims[0])
+    throw ResultsError(what + ": has " + std::to_string(dims[0]) + " rows, not rows " + std::to_string(first + 1) + " to " +
+                       std::to_string(first + count));
+  Table out;
+  out.rows = count;
+  out.cols = static_cast<long>(dims[1]);
+  out.data.resize(static_cast<size_t>(count) * dims[1]);
+  if (out.data.empty()) return out;
+  const h5::Handle fspace = h5::space(H5Dget_space(d), what);
+  const hsize_t start[2] = {static_cast<hsize_t>(first), 0}, size[2] = {static_cast<hsize_t>(count), dims[1]};
+  h5::check(H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start, nullptr, size, nullptr), what);
+  const h5::Handle mspace = h5::space(H5Screate_simple(2, size, nullptr), what);
+  h5::check(H5Dread(d, H5T_NATIVE_DOUBLE, mspace, fspace, H5P_DEFAULT, out.data.data()), what);
   return out;
 }
 

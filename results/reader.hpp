@@ -37,6 +37,8 @@ class ResultsReader {
   bool has(const std::string& object) const;
   /// The 2-D float64 dataset `object`; throws ResultsError if it is missing or not 2-D.
   Table table(const std::string& object) const;
+  /// Rows first … first + count − 1 of it (a damaged chunk elsewhere does not matter); throws like table().
+  Table rows(const std::string& object, long first, long count) const;
   /// Rows and columns of the 2-D dataset `object`, without reading it; throws like table().
   std::pair<long, long> shape(const std::string& object) const;
   /// The names of the members of group `group` ("/" for the file), in name order.

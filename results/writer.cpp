@@ -71,6 +71,7 @@ ResultsWriter::ResultsWriter(const std::string& path, const FileDescription& d) 
   if (d.n >= 0) file_->attribute("/", "n", d.n);
   if (d.n_option >= 0) file_->attribute("/", "n_option", d.n_option);
   file_->attribute("/", "threads", d.threads);
+  file_->case_sum = writer_detail::case_checksum(d.case_text, d.overrides, d.n_option);
 }
 
 ResultsWriter::ResultsWriter(const std::string& path, Reopen) : file_(std::make_shared<File>()) {
@@ -88,6 +89,7 @@ ResultsWriter::ResultsWriter(const std::string& path, Reopen) : file_(std::make_
   hbool_t clear = true;
   h5::check(H5Pset(fapl, "clear_status_flags", &clear), path + ": reopening");
   file_->id = h5::file(H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl), path + ": cannot reopen the results file to resume it");
+  file_->case_sum = writer_detail::case_checksum(file_->id, path + ": reading its case");
 }
 
 ResultsWriter::~ResultsWriter() {
@@ -114,7 +116,8 @@ namespace {
 void put_vector(hid_t g, const char* name, const std::vector<double>& v, const std::string& what) {
   const hsize_t dims[1] = {v.size()};
   const h5::Handle sp = h5::space(H5Screate_simple(1, dims, nullptr), what);
-  const h5::Handle ds = h5::dataset(H5Dcreate2(g, name, H5T_NATIVE_DOUBLE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), what);
+  const h5::Handle dcpl = h5::checked_layout(1, dims, what);
+  const h5::Handle ds = h5::dataset(H5Dcreate2(g, name, H5T_NATIVE_DOUBLE, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT), what);
   if (!v.empty()) h5::check(H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), what);
 }
 }  // namespace
@@ -165,7 +168,8 @@ void ResultsWriter::write_table(const std::string& name, const Table& t, const s
   const h5::Handle sp = h5::space(H5Screate_simple(2, dims, nullptr), what);
   const h5::Handle lcpl = h5::plist(H5Pcreate(H5P_LINK_CREATE), what);
   h5::check(H5Pset_create_intermediate_group(lcpl, 1), what);
-  const h5::Handle ds = h5::dataset(H5Dcreate2(f.id, name.c_str(), H5T_NATIVE_DOUBLE, sp, lcpl, H5P_DEFAULT, H5P_DEFAULT), what);
+  const h5::Handle dcpl = h5::checked_layout(2, dims, what);
+  const h5::Handle ds = h5::dataset(H5Dcreate2(f.id, name.c_str(), H5T_NATIVE_DOUBLE, sp, lcpl, dcpl, H5P_DEFAULT), what);
   if (!t.data.empty()) h5::check(H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, t.data.data()), what);
   h5::write_attribute(ds, "columns", columns);
   h5::write_attribute(ds, "units", units);
@@ -256,8 +260,9 @@ std::unique_ptr<RunWriter> ResultsWriter::begin_run(const std::string& name, std
     const std::string what = w.what("creating " + info.name + " in");
     const hsize_t dims[2] = {values.size() / info.width(), static_cast<hsize_t>(info.width())};
     const h5::Handle sp = h5::space(H5Screate_simple(2, dims, nullptr), what);
+    const h5::Handle dcpl = h5::checked_layout(2, dims, what);
     const h5::Handle ds =
-        h5::dataset(H5Dcreate2(w.group, info.name.c_str(), H5T_NATIVE_DOUBLE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), what);
+        h5::dataset(H5Dcreate2(w.group, info.name.c_str(), H5T_NATIVE_DOUBLE, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT), what);
     h5::check(H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), what);
     h5::write_attribute(ds, "columns", info.columns);
     h5::write_attribute(ds, "units", info.units);

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <variant>
 
@@ -19,6 +20,12 @@ namespace writer_detail {
 
 /// The attributes that describe a run, queued for the end of its SWMR writing.
 void queue_run_description(ResultsWriter::File& f, const std::string& run, const RunDescription& d);
+
+/// The checksum of what defines a file's model and runs (the case text, its --set overrides, the n
+/// asked for), kept in every checkpoint: a checkpoint of another case is refused.
+uint64_t case_checksum(const std::string& case_text, const std::string& overrides, long n_option);
+/// The same, from the file's attributes.
+uint64_t case_checksum(hid_t file, const std::string& what);
 
 inline double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -44,6 +51,7 @@ struct ResultsWriter::File {
   h5::Handle id;
   int lock_fd = -1;  // holds the open-file-description lock that keeps other rfem writers out
   bool swmr = false;
+  uint64_t case_sum = 0;  // writer_detail::case_checksum of the file's case
   using Value = std::variant<std::string, double, long>;
   struct Pending {
     std::string object, key;
@@ -166,6 +174,7 @@ struct RunWriter::Impl {
     const h5::Handle plist = h5::plist(H5Pcreate(H5P_DATASET_CREATE), w);
     const hsize_t chunk[2] = {std::max<hsize_t>(1, std::min<hsize_t>(256, (1 << 16) / dims[1])), dims[1]};
     h5::check(H5Pset_chunk(plist, 2, chunk), w);
+    h5::checksummed(plist, w);  // damaged rows fail on read instead of reading as numbers
     const h5::Handle lcpl = h5::plist(H5Pcreate(H5P_LINK_CREATE), w);  // "links/NAME/tip" creates its groups
     h5::check(H5Pset_create_intermediate_group(lcpl, 1), w);
     Series s;

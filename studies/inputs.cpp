@@ -9,6 +9,7 @@
 
 #include "rfem/assembly/assemble.hpp"
 #include "rfem/results/reader.hpp"
+#include "rfem/solvers/run_status.hpp"
 
 namespace rfem {
 
@@ -52,7 +53,7 @@ std::shared_ptr<TorqueLaw> torque_from_results(const InputSpec& in, int joint, d
   if (t_end > times.back() * (1 + 1e-12) + 1e-12)
     throw CaseError(in.where + ": " + source + " ends at t = " + fmt::format("{}", times.back()) + " s (" + status +
                     "), before simulation.t_end = " + fmt::format("{}", t_end) + " s");
-  if (status != "completed" && warn)
+  if (!RunStatus::parse(status).is_completed() && warn)
     warn(fmt::format("{}: the source run '{}' did not complete ({}); its torques are used up to t = {} s", in.where, in.run,
                      status, times.back()));
   return spline_torque(times, values);

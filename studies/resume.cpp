@@ -1,10 +1,12 @@
 #include "rfem/studies/resume.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <sstream>
 
 #include "rfem/results/writer.hpp"
+#include "rfem/studies/checkpoints.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/recorders.hpp"
 
@@ -44,7 +46,7 @@ ResumePlan plan_resume(const std::string& path) {
     for (RunName r : runs_of(p.cs.sim.procedure)) {
       const std::string run = to_string(r);
       if (!in.has(run)) break;  // (not begun: it and the later runs run from t = 0)
-      if (in.attribute(run, "status") == "completed") {
+      if (RunStatus::parse(in.attribute(run, "status")).is_completed()) {
         p.done.push_back(run);
         continue;
       }
@@ -57,11 +59,62 @@ ResumePlan plan_resume(const std::string& path) {
   return p;
 }
 
+namespace {
+
+// Everything a resume keeps, checked before the file is opened for writing (that open already
+// changes it), so a refused resume leaves the file byte for byte as it was: every series of a run
+// kept whole or up to its checkpoint has the model's width and the rows kept, they read back
+// (their Fletcher-32 checksums agree) and are finite; the checkpoint's state unpacks.
+void verify_kept(const ResumePlan& plan, const Model& model) {
+  try {
+    const ResultsReader in(plan.path);
+    auto verify = [&](const std::string& run, const std::vector<SeriesInfo>& series, long keep) {
+      for (const SeriesInfo& s : series) {
+        const std::string what = plan.path + ": " + run + "/" + s.name;
+        const Table t = in.table(run + "/" + s.name);
+        const long rows = keep < 0 ? t.rows : keep;
+        if (t.cols != s.width() || t.rows < rows)
+          throw CaseError(what + ": " + std::to_string(t.rows) + " × " + std::to_string(t.cols) + " does not fit " +
+                          (keep < 0 ? "the case's model" : "the checkpoint (" + std::to_string(rows) + " rows × " +
+                                                               std::to_string(s.width()) + ")") +
+                          ": not resumed");
+        for (long i = 0; i < rows * t.cols; ++i)
+          if (!std::isfinite(t.data[static_cast<size_t>(i)]))
+            throw CaseError(what + ": row " + std::to_string(i / t.cols + 1) + " is not finite (damaged): not resumed");
+      }
+    };
+    auto layout_of = [&](const std::string& run) {
+      const bool rigid = plan.cs.sim.procedure == Procedure::Paper && run == to_string(RunName::Rigid);
+      return run_layout(rigid ? rigidify(model) : model, plan.cs.sim.flexible_every);
+    };
+    for (const std::string& run : plan.done) {
+      const RunLayout l = layout_of(run);
+      verify(run, l.series, -1);
+      verify(run, l.flexible, -1);
+    }
+    for (const auto& [run, c] : plan.resume) {
+      const RunLayout l = layout_of(run);
+      verify(run, l.series, c.rows);
+      verify(run, l.flexible, c.flexible_rows);
+      try {
+        RunState::unpack(c.state, -1);
+      } catch (const std::invalid_argument& e) {
+        throw CaseError(plan.path + ": " + run + ": " + e.what() + ": not resumed");
+      }
+    }
+  } catch (const ResultsError& e) {
+    throw CaseError(std::string(e.what()) + ": not resumed");
+  }
+}
+
+}  // namespace
+
 std::vector<RunResult> resume_case(const ResumePlan& plan, RunRequest rq) {
   const Case& cs = plan.cs;
   if (plan.finished()) return {};
   const auto model = model_of(cs, plan.n);
   const std::vector<JointInput> inputs = joint_inputs(cs, rq.warn);
+  verify_kept(plan, *model);
   rq.n = plan.n;
   rq.runs.clear();
   rq.done = plan.done;

@@ -110,3 +110,86 @@ for bad in missing.h5 junk.h5 refine.h5; do
   fi
   echo "ok   --resume $bad: $err"
 done
+# Damaged and foreign files (issue 34): one line, exit 2, never a wait in HDF5's SWMR retry loop, and
+# a refused resume leaves the file byte for byte as it was. A killed run's file cut to half, a
+# torque_from_run source with flipped bytes (tests/data), resumed, plotted, read.
+data="$src/tests/data"
+cp "$data/cut_killed.h5" cut.h5 && chmod u+w cut.h5 && cp cut.h5 cut0.h5
+cp "$data/corrupt_source.h5" corrupt.h5
+printf '[materials.al]\nE = 7e10\nG = 2.7e10\nrho = 2700.0\n[sections.s]\nA = 4e-4\nIy = 2e-7\nIz = 2e-7\nJ = 4e-7\n[link]\nn = 4\n[[link.segments]]\nlength = 1.0\nmaterial = "al"\nsection = "s"\n[[joints]]\nname = "hub"\ninput = { kind = "torque_from_run", file = "corrupt.h5", run = "run", joint = 1 }\n[simulation]\nt_end = 0.3\noutput_dt = 0.01\n' > tfr.toml
+expect2() {  # NAME COMMAND…: exit 2 with one line on stderr, no traceback, within 60 s
+  local name=$1; shift
+  set +e
+  err=$(timeout 60 "$@" 2>&1 >/dev/null)
+  rc=$?
+  set -e
+  if [ "$rc" != 2 ] || [ "$(printf '%s\n' "$err" | wc -l)" != 1 ] || grep -q Traceback <<<"$err"; then
+    echo "FAIL $name: exit $rc, stderr: $err"
+    exit 1
+  fi
+  echo "ok   $name: $err"
+}
+expect2 "--resume of a cut file" "$rfem" run --resume cut.h5 -q
+cmp -s cut.h5 cut0.h5 || { echo "FAIL the refused resume changed cut.h5"; exit 1; }
+expect2 "plot of a cut file" "$rfem" plot cut.h5 -o plots
+expect2 "torque_from_run of a damaged source" "$rfem" run tfr.toml -q -o tfr.h5
+# A checkpoint of the same case with another gain, of another case, and flipped bytes in the rows a
+# resume keeps: refused (the case checksum in each checkpoint; the datasets' Fletcher-32 checksums),
+# the file unchanged. Runs stopped by SIGINT after a checkpoint that keeps 3 outputs (n = 40: seconds).
+RFEM="$rfem" SRC="$src" /usr/bin/python3 - <<'PY'
+import os, shutil, signal, subprocess, time
+import h5py, numpy as np
+
+rfem, src = os.environ["RFEM"], os.environ["SRC"]
+
+def stopped(out, case, *extra):  # a run stopped by SIGINT once its first checkpoint is in the file
+    p = subprocess.Popen([rfem, "--threads", "1", "run", f"{src}/cases/{case}", "--n", "40", "-o", out, "-q",
+                          "--checkpoint", "0.05", "--set", "simulation.t_end=600"] + list(extra))
+    t0 = time.time()
+    while p.poll() is None and time.time() - t0 < 120:
+        try:
+            with h5py.File(out, "r", swmr=True) as f:
+                c = f["run/checkpoint"]
+                if c.shape[1] > 0 and c[:, 2].max() >= 3:  # a checkpoint that keeps 3 outputs
+                    break
+        except (OSError, KeyError):
+            pass
+        time.sleep(0.05)
+    p.send_signal(signal.SIGINT)
+    assert p.wait() == 130, out
+
+stopped("arm.h5", "two_link_arm.toml")
+stopped("arm_kp.h5", "two_link_arm.toml", "--set", "joints.0.input.kp=55.0")
+stopped("spin.h5", "kane_spinup.toml")
+
+def graft(into, source, out):  # `into` with the checkpoint slots of `source`
+    shutil.copy(into, out)
+    with h5py.File(out, "r+") as a, h5py.File(source, "r") as b:
+        ca, cb = a["run/checkpoint"], b["run/checkpoint"][()]
+        if ca.shape[1] < cb.shape[1]:
+            ca.resize(cb.shape)
+        t = np.zeros(ca.shape)
+        t[:, :cb.shape[1]] = cb
+        ca[...] = t
+
+graft("arm.h5", "arm_kp.h5", "gain.h5")
+graft("arm.h5", "spin.h5", "foreign.h5")
+shutil.copy("arm.h5", "flipped.h5")  # the bytes of the kept output times 2 and 3 changed
+with h5py.File("arm.h5", "r") as f:
+    t = f["run/time"][1:3, 0]
+data = open("flipped.h5", "rb").read()
+at = data.find(t.astype("<f8").tobytes())
+assert at >= 0, "the output times are not in the file"
+with open("flipped.h5", "r+b") as raw:
+    raw.seek(at)
+    raw.write(np.array([np.nan, 1e300]).astype("<f8").tobytes())
+fails = 0
+for name in ("gain.h5", "foreign.h5", "flipped.h5"):
+    before = open(name, "rb").read()
+    r = subprocess.run([rfem, "--threads", "1", "run", "--resume", name, "-q"], capture_output=True, text=True, timeout=120)
+    lines = r.stderr.strip().splitlines()
+    ok = r.returncode == 2 and len(lines) == 1 and name in lines[0] and open(name, "rb").read() == before
+    print("ok  " if ok else "FAIL", f"--resume {name}: refused, file unchanged (exit {r.returncode}: {r.stderr.strip()})")
+    fails += not ok
+raise SystemExit(1 if fails else 0)
+PY

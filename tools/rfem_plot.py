@@ -454,7 +454,7 @@ def main(argv=None):
                 f.visititems(lambda name, obj: units.extend(list_attr(obj, "joint_units"))
                              if not units and isinstance(obj, h5py.Group) and "joint_units" in obj.attrs else None)
                 plot_refine(f["refine"], outdir, os.path.splitext(os.path.basename(case))[0] if case else "", units)
-    except (OSError, KeyError, ValueError, IndexError, TypeError) as exc:
+    except (OSError, KeyError, ValueError, IndexError, TypeError, RuntimeError) as exc:  # (h5py: damaged files)
         reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         print("rfem plot: error: %s: %s" % (args.result, reason), file=sys.stderr)
         return 2
