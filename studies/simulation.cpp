@@ -265,24 +265,31 @@ std::shared_ptr<const Model> Simulation::shared_model() const { return impl_->mo
 double Simulation::time() const { return impl_->stepper->time(); }
 double Simulation::t_end() const { return impl_->o.t_end; }
 
+namespace {
+// Every coordinate (rates: every rate) from the unknowns and the prescribed joints' laws at t.
+VecX full(const Model& model, const EquationsOfMotion& eq, const std::vector<JointInput>& inputs, const VecX& unknowns,
+          double t, bool rates) {
+  VecX x = VecX::Zero(model.dof());
+  for (int i = 0; i < eq.unknowns(); ++i) x[eq.unknown_index(i)] = unknowns[i];
+  for (int j = 0; j < model.m(); ++j)
+    if (inputs[j].prescribed()) {
+      const MotionSample s = inputs[j].motion->at(t);
+      x[model.joint_index(j)] = rates ? s.qd : s.q;
+    }
+  return x;
+}
+}  // namespace
+
 VecX Simulation::q() const {
   const Impl& m = *impl_;
   const IntegratorState x = m.stepper->state();
-  VecX q = VecX::Zero(m.model->dof());
-  for (int i = 0; i < m.eq->unknowns(); ++i) q[m.eq->unknown_index(i)] = x.q[i];
-  for (int j = 0; j < m.model->m(); ++j)
-    if (m.inputs[j].prescribed()) q[m.model->joint_index(j)] = m.inputs[j].motion->at(x.t).q;
-  return q;
+  return full(*m.model, *m.eq, m.inputs, x.q, x.t, false);
 }
 
 VecX Simulation::v() const {
   const Impl& m = *impl_;
   const IntegratorState x = m.stepper->state();
-  VecX v = VecX::Zero(m.model->dof());
-  for (int i = 0; i < m.eq->unknowns(); ++i) v[m.eq->unknown_index(i)] = x.v[i];
-  for (int j = 0; j < m.model->m(); ++j)
-    if (m.inputs[j].prescribed()) v[m.model->joint_index(j)] = m.inputs[j].motion->at(x.t).qd;
-  return v;
+  return full(*m.model, *m.eq, m.inputs, x.v, x.t, true);
 }
 
 std::vector<std::string> Simulation::coordinate_names() const {

@@ -24,9 +24,8 @@ Case hub(double t_end) {
                    {"simulation.t_end=" + std::to_string(t_end), "link.n=6", "simulation.output_dt=0.01"});
 }
 
-// The same beam on a PD-controlled hub following Kane's spin-up to 2 rad/s in 1 s (no feed-forward).
-Case pd_hub() {
-  return parse_case(R"(
+// Kane's aluminium and section (cases/kane_beam.toml).
+constexpr const char* kKaneMaterial = R"(
 [materials.kane]
 E = 7.0e10
 G = 2.6923076923e10
@@ -36,6 +35,11 @@ A = 4.0e-4
 Iy = 2.0e-7
 Iz = 2.0e-7
 J = 4.0e-7
+)";
+
+// The same beam on a PD-controlled hub following Kane's spin-up to 2 rad/s in 1 s (no feed-forward).
+Case pd_hub() {
+  return parse_case(std::string(kKaneMaterial) + R"(
 [[joints]]
 name = "hub"
 drive = { inertia = 50.0 }
@@ -258,16 +262,7 @@ TEST(Simulation, StrainGaugesReadTheBeamsBendingMomentAndSensorsAreReproducible)
   // rfes' masses lie beyond the sde exactly as the beam's), so a gauge at c above the axis reads
   // ε = M c / (E Iy) (tension on top). The deflection is 4e-4 of L: the geometry's change of the
   // lever arms is far below the 1e-4 asserted.
-  const Case cs = parse_case(R"(
-[materials.kane]
-E = 7.0e10
-G = 2.6923076923e10
-rho = 3000.0
-[sections.kane]
-A = 4.0e-4
-Iy = 2.0e-7
-Iz = 2.0e-7
-J = 4.0e-7
+  const Case cs = parse_case(std::string(kKaneMaterial) + R"(
 [[joints]]
 name = "hub"
 input = { kind = "constant_rate", rate = 0.0 }
