@@ -25,8 +25,24 @@ std::shared_ptr<TorqueLaw> torque_from_results(const InputSpec& in, int joint, d
   } catch (const ResultsError&) {
     throw CaseError(in.where + ".file: '" + in.file + "' is not a readable HDF5 results file");
   }
-  if (!f->has(in.run + "/time") || !f->has(in.run + "/joint_tau"))
+  if (!f->has(in.run + "/time") || !f->has(in.run + "/joint_tau")) {
+    // has() is false also where damage stops HDF5 on the way: an object its group lists, unreadable.
+    auto damaged = [&](const std::string& group, const std::string& name) {
+      const std::string object = group == "/" ? name : group + "/" + name;
+      if (f->has(object)) return false;
+      try {
+        const std::vector<std::string> names = f->children(group);
+        return std::find(names.begin(), names.end(), name) != names.end();
+      } catch (const ResultsError&) {
+        return true;  // (the group exists: has() said so, or it is the root)
+      }
+    };
+    for (const auto& [group, name] : {std::pair<std::string, std::string>{"/", in.run}, {in.run, "time"}, {in.run, "joint_tau"}})
+      if ((group == "/" || f->has(group)) && damaged(group, name))
+        throw CaseError(in.where + ".file: '" + in.file + "' is damaged: '" + (group == "/" ? name : group + "/" + name) +
+                        "' cannot be read");
     throw CaseError(in.where + ".run: no run '" + in.run + "' with time and joint_tau in '" + in.file + "'");
+  }
   Table t, tau;
   try {
     t = f->table(in.run + "/time");
