@@ -55,23 +55,35 @@ int claim(const std::string& path, const std::string& case_path) {
 ResultsWriter::ResultsWriter(const std::string& path, const FileDescription& d) : file_(std::make_shared<File>()) {
   const h5::Quiet quiet;
   file_->path = path;
+  std::error_code ec;
+  const bool existed = std::filesystem::exists(path, ec);
   file_->lock_fd = claim(path, d.case_path);
-  file_->require(kMargin);
-  const h5::Handle fapl = latest_fapl();
-  file_->id = h5::file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl),
-                       path + ": cannot create results file (is the directory writable?)");
-  file_->attribute("/", "rfem_version", std::string(version_string));
-  file_->attribute("/", "build", std::string(build_description()));
-  file_->attribute("/", "command_line", d.command_line);
-  file_->attribute("/", "case_path", d.case_path);
-  file_->attribute("/", "case_text", d.case_text);
-  file_->attribute("/", "case_effective", d.case_effective);
-  file_->attribute("/", "overrides", d.overrides);
-  file_->attribute("/", "procedure", d.procedure);
-  if (d.n >= 0) file_->attribute("/", "n", d.n);
-  if (d.n_option >= 0) file_->attribute("/", "n_option", d.n_option);
-  file_->attribute("/", "threads", d.threads);
-  file_->case_sum = writer_detail::case_checksum(d.case_text, d.overrides, d.n_option);
+  bool created = false;
+  try {
+    file_->require(kMargin);
+    const h5::Handle fapl = latest_fapl();
+    file_->id = h5::file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl),
+                         path + ": cannot create results file (is the directory writable?)");
+    created = true;
+    file_->attribute("/", "rfem_version", std::string(version_string));
+    file_->attribute("/", "build", std::string(build_description()));
+    file_->attribute("/", "command_line", d.command_line);
+    file_->attribute("/", "case_path", d.case_path);
+    file_->attribute("/", "case_text", d.case_text);
+    file_->attribute("/", "case_effective", d.case_effective);
+    file_->attribute("/", "overrides", d.overrides);
+    file_->attribute("/", "procedure", d.procedure);
+    if (d.n >= 0) file_->attribute("/", "n", d.n);
+    if (d.n_option >= 0) file_->attribute("/", "n_option", d.n_option);
+    file_->attribute("/", "threads", d.threads);
+    file_->case_sum = writer_detail::case_checksum(d.case_text, d.overrides, d.n_option);
+  } catch (...) {
+    // A file that could not be made whole (a full disk, a size limit) is not left behind empty
+    // (a file that stood there before is removed only once the creation has truncated it).
+    file_->id.reset();
+    if (!existed || created) std::filesystem::remove(path, ec);
+    throw;
+  }
 }
 
 ResultsWriter::ResultsWriter(const std::string& path, Reopen) : file_(std::make_shared<File>()) {

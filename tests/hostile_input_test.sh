@@ -185,5 +185,11 @@ one_line 1 "ulimit -f 200"
 s=$(status fsize.h5 run)
 [[ $s == "failed: cannot write "*"file size limit"* ]] && ok "its file reads plainly: ${s:0:50}…" || bad "ulimit -f: $s"
 
+# A file that cannot even be created whole (no room for its header) is not left behind empty
+# (once: a 0-byte out.h5).
+(ulimit -f 1; exec "$rfem" --threads 1 run "$src/cases/two_link_arm.toml" --set simulation.t_end=0.1 -q -o nofile.h5 2> err.txt); code=$?
+one_line 2 "ulimit -f 1 (1 kB: room for this message, not for a file)"
+[ ! -e nofile.h5 ] && ok "no empty file left" || bad "ulimit -f 0 left $(stat -c %s nofile.h5)-byte nofile.h5 (ulimit -f 1)"
+
 [ $fail = 0 ] && echo "all passed" || echo "failures above"
 exit $fail
