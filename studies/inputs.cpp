@@ -179,11 +179,13 @@ std::vector<JointInput> rigid_torque_inputs(std::shared_ptr<const Model> rigid, 
   // at one time, and a stage's Newton iterations ask at the same time again. (Locked: two runs may
   // share these inputs.)
   struct Last {
+    explicit Last(const Model& rigid) : ws(rigid) {}
     std::mutex m;
     double t = std::numeric_limits<double>::quiet_NaN();
     VecX F;
+    Workspace ws;  // the inverse dynamics' scratch, bound to the rigid model
   };
-  const auto last = std::make_shared<Last>();
+  const auto last = std::make_shared<Last>(*rigid);
   std::vector<JointInput> out(laws.size());
   for (size_t j = 0; j < laws.size(); ++j) {
     out[j].q0 = laws[j].q0;
@@ -199,7 +201,7 @@ std::vector<JointInput> rigid_torque_inputs(std::shared_ptr<const Model> rigid, 
           v[i] = s.qd;
           a[i] = s.qdd;
         }
-        generalised_forces(*rigid, q, v, a, ForceTerms{}, last->F);
+        generalised_forces(*rigid, q, v, a, ForceTerms{}, last->F, nullptr, &last->ws);
         last->t = t;
       }
       return last->F[static_cast<long>(j)];
