@@ -5,6 +5,7 @@
 #include <fmt/core.h>
 
 #include <Eigen/Core>
+#include <cmath>
 #include <sstream>
 
 #include <csignal>
@@ -34,6 +35,20 @@ CLI::Validator positive_int(long max) {
       "POSITIVE");
 }
 const CLI::Validator kPositiveInt = positive_int(100000000);
+// A finite number ≥ 0 (CLI11's NonNegativeNumber lets "nan" through).
+const CLI::Validator kNonNegativeFinite(
+    [](std::string& s) -> std::string {
+      size_t used = 0;
+      double v = NAN;
+      try {
+        v = std::stod(s, &used);
+      } catch (...) {
+        used = 0;
+      }
+      if (used == 0 || used != s.size() || !std::isfinite(v) || v < 0) return "must be a finite number, 0 or more (got '" + s + "')";
+      return "";
+    },
+    "NONNEGATIVE");
 const CLI::Validator kRfes = positive_int(rfem::kMaxRfes);  // the case file's own limit
 
 }  // namespace
@@ -95,7 +110,7 @@ int main(int argc, char** argv) {
       ->excludes(rn->get_option("-o"));
   rn->add_option("--checkpoint", run_options.checkpoint,
                  fmt::format("seconds of wall time between checkpoints (0: none; default {:g})", rfem::kCheckpointInterval))
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegativeFinite);
   auto* pl = app.add_subcommand("plot", "PNG figures of a results file (the paper's Figures 5-8, runs, refinement)");
   std::string plot_file, plot_dir;
   pl->add_option("results", plot_file, "results file (HDF5) from rfem run or rfem refine")->required();

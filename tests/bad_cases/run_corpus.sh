@@ -6,7 +6,7 @@
 #
 # Each case file starts with
 #   # expect: <substring of the one-line error message>
-#   # command: static | modes | run
+#   # command: static | modes | run  (and options: modes --n 1)
 # Cases run in a fresh temporary directory (results files never land in the repository); files a
 # case leaves behind are reported as a note. Prints `ok NN_name` or `FAIL NN_name: <why>` per
 # file and `N passed, M failed`; exits 1 if any case failed.
@@ -60,7 +60,9 @@ for file in "${cases[@]}"; do
   work="$scratch/$name"
   mkdir -p "$work"
   # (the outer 2>/dev/null silences bash's own "Segmentation fault" report; rfem's stderr goes to .err)
-  { (cd "$work" && exec timeout "$timeout_s" "$rfem" "$command" "$file") >"$scratch/$name.out" 2>"$scratch/$name.err"; } 2>/dev/null
+  # (`# command:` may carry options: "modes --n 1")
+  # shellcheck disable=SC2086
+  { (cd "$work" && exec timeout "$timeout_s" "$rfem" $command "$file") >"$scratch/$name.out" 2>"$scratch/$name.err"; } 2>/dev/null
   rc=$?
   err=$(cat "$scratch/$name.err")
   lines=$(awk 'END { print NR }' "$scratch/$name.err")
