@@ -132,8 +132,13 @@ expect2() {  # NAME COMMAND…: exit 2 with one line on stderr, no traceback, wi
 expect2 "--resume of a cut file" "$rfem" run --resume cut.h5 -q
 cmp -s cut.h5 cut0.h5 || { echo "FAIL the refused resume changed cut.h5"; exit 1; }
 expect2 "plot of a cut file" "$rfem" plot cut.h5 -o plots
-expect2 "torque_from_run of a damaged source" "$rfem" run tfr.toml -q -o tfr.h5
-grep -q "'corrupt.h5' is damaged" <<<"$err" || { echo "FAIL the damaged source not called damaged"; exit 1; }
+# (Not under the sanitizers: HDF5 1.10.8 itself reads uninitialised memory while it lists this
+# damaged group — valgrind shows it inside libhdf5 in the Release build too — and AddressSanitizer
+# aborts on what follows; the Release run checks rfem's answer.)
+if [ "${2:-0}" != 1 ]; then
+  expect2 "torque_from_run of a damaged source" "$rfem" run tfr.toml -q -o tfr.h5
+  grep -q "'corrupt.h5' is damaged" <<<"$err" || { echo "FAIL the damaged source not called damaged"; exit 1; }
+fi
 # A checkpoint of the same case with another gain, of another case, and flipped bytes in the rows a
 # resume keeps: refused (the case checksum in each checkpoint; the datasets' Fletcher-32 checksums),
 # the file unchanged. Runs stopped by SIGINT after a checkpoint that keeps 3 outputs (n = 40: seconds).
