@@ -23,8 +23,7 @@ constexpr double kStateVersion = 1.0;
 constexpr int kHeldNone = 0, kHeldTorque = 1, kHeldReference = 2, kDriveValues = 5;
 
 // A force-input joint's law with a value the caller may hold instead (zero-order hold): a torque,
-// or a PD reference with the case's gains. The Newton matrix keeps the case law's feedback gains
-// (its stiffness and damping): they only speed the Newton iteration up, the solution is the law's.
+// or a PD reference with the case's gains.
 class HeldLaw : public TorqueLaw {
  public:
   explicit HeldLaw(std::shared_ptr<TorqueLaw> base) : base_(std::move(base)) {}
@@ -36,8 +35,10 @@ class HeldLaw : public TorqueLaw {
     if (mode == kHeldReference) return tau_ff + base_->stiffness() * (q_ref - q) + base_->damping() * (v_ref - v);
     return base_->at(t, q, v);
   }
-  double stiffness() const override { return base_->stiffness(); }
-  double damping() const override { return base_->damping(); }
+  // −∂τ/∂q, −∂τ/∂v of the law in force (the power's first-order update uses them): none for a held
+  // torque. (The Newton matrix keeps the case's gains, set once: they only speed Newton up.)
+  double stiffness() const override { return mode == kHeldTorque ? 0.0 : base_->stiffness(); }
+  double damping() const override { return mode == kHeldTorque ? 0.0 : base_->damping(); }
   std::vector<double> breakpoints() const override { return base_->breakpoints(); }
   bool feedback() const { return base_->stiffness() > 0 || base_->damping() > 0; }
   int mode = kHeldNone;
@@ -127,6 +128,7 @@ struct Simulation::Impl {
   std::unique_ptr<SampleEmitter> emit;  // (after sink and control: it refers to them)
   RunStatus status;
   bool changed = false;  // a held value changed since the last step
+  VecX scratch;          // a snapshot's residual
   std::optional<RunResult> result;
   struct PendingTable {
     std::string name;
@@ -199,7 +201,6 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
     if (!(from->time() >= 0 && from->time() < m.o.t_end))
       throw std::invalid_argument("the state's time " + std::to_string(from->time()) + " s is not before simulation.t_end = " +
                                   std::to_string(m.o.t_end) + " s");
-    m.apply_drives(from->drives);
     m.resume = from->integrator;
     m.resume.stats = {};
     // The outputs after the state's time, on this run's grid (the state's own row is written below).
@@ -227,6 +228,7 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
   m.book = std::make_unique<RunBook>("run", m.model, m.inputs, cs, m.rq, m.o);
   if (!cs.sensors.empty()) m.sensors = std::make_unique<SensorBank>(cs, *m.model);
   m.eq = std::make_unique<EquationsOfMotion>(m.model, m.inputs, m.o.forces, m.rq.stop, m.o.linear_solver, m.o.parallel);
+  if (from) m.apply_drives(from->drives);  // (after the equations took the case laws' gains for Newton)
   if (m.eq->unknowns() == 0)
     throw CaseError(cs.path + ": joints: every joint follows a prescribed motion and there is no flexible link: nothing to step "
                               "(rfem run computes its torques)");
@@ -363,19 +365,23 @@ Snapshot Simulation::snapshot() {
   m.require_running("snapshot");
   m.bring_inputs_up_to_date();
   const IntegratorState x = m.stepper->state();
-  const OutputSample s = m.eq->sample(x.t, x.q.data(), x.v.data(), x.a.data(), x.dissipated, x.input_work);
+  // The equations at the state give the joints' torques (applied, or required by a prescribed
+  // motion); a snapshot needs no energies or momentum (an output sample's extra passes).
+  m.scratch.resize(m.eq->unknowns());
+  m.eq->residual(x.t, x.q.data(), x.v.data(), x.a.data(), m.scratch.data());
+  const VecX q = full(*m.model, *m.eq, m.inputs, x.q, x.t, false), v = full(*m.model, *m.eq, m.inputs, x.v, x.t, true);
   Snapshot y;
   y.t = x.t;
-  y.joint_q = m.model->joint_coords(s.q);
-  y.joint_v = m.model->joint_coords(s.v);
-  y.joint_tau = s.tau;
+  y.joint_q = m.model->joint_coords(q);
+  y.joint_v = m.model->joint_coords(v);
+  y.joint_tau = m.eq->torques(x.t);
   for (size_t l = 0; l < m.model->links.size(); ++l) {
-    y.tip_position.push_back(tip_position(*m.model, static_cast<int>(l), s.q));
-    y.tip_deflection.push_back(tip_deflection(*m.model, static_cast<int>(l), s.q));
+    y.tip_position.push_back(tip_position(*m.model, static_cast<int>(l), q));
+    y.tip_deflection.push_back(tip_deflection(*m.model, static_cast<int>(l), q));
   }
   if (m.sensors) {
     std::vector<double> values;
-    m.sensors->read(s.q, s.v, s.tau, values, 0);
+    m.sensors->read(q, v, y.joint_tau, values, 0);
     size_t k = 0;
     for (size_t i = 0; i < m.sensors->size(); ++i) {
       const auto w = static_cast<size_t>(m.sensors->width(i));
