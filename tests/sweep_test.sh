@@ -66,36 +66,40 @@ n = [$kill_n]
 "joints.0.input.T" = [10.0, 11.0, 12.0, 13.0]
 TOML
 completed() { /usr/bin/python3 -c "import h5py; print(list(h5py.File('$1','r').attrs['status']).count('completed'))" 2>/dev/null || echo 0; }
+# Waits until a point has finished and one that has not has written a checkpoint early in its run
+# (≤ 32 of its 81 output rows): a signal then lands inside that point however fast points run (a
+# fixed delay after the first point's end raced the next point's start).
+wait_inside_a_later_point() {
+  /usr/bin/python3 - <<'PY'
+import os, sys, time
+import h5py
+end = time.time() + 600
+while time.time() < end:
+    try:
+        with h5py.File("k.h5", "r") as f:
+            status = [str(x) for x in f.attrs["status"]]
+    except Exception:
+        status = []
+    if 1 <= status.count("completed") < len(status):
+        for k, st in enumerate(status):
+            if st == "completed" or not os.path.exists(f"k.runs/run{k:04d}.h5"):
+                continue
+            try:
+                with h5py.File(f"k.runs/run{k:04d}.h5", "r", swmr=True) as r:
+                    slots = r["run/checkpoint"][:, :3]  # magic, sequence, rows
+                if any(0 < s[2] <= 32 for s in slots if s[0] != 0):
+                    sys.exit(0)
+            except Exception:
+                pass
+    time.sleep(0.01)
+sys.exit(1)
+PY
+}
 for sig in KILL INT; do
   rm -rf k.h5 k.runs
   "$rfem" sweep k.toml --jobs 1 -q 2>/dev/null &
   pid=$!
-  # Kill once a point after the first has written a checkpoint early in its run (≤ 32 of its 81
-  # output rows): the signal then lands inside that point however fast points run (a fixed delay
-  # after the first point's end raced the next point's start).
-  /usr/bin/python3 - <<'PY' || { echo "FAIL: SIG$sig: no point after the first wrote an early checkpoint"; exit 1; }
-import sys, time
-import h5py
-def done():
-    try:
-        with h5py.File("k.h5", "r") as f:
-            return list(f.attrs["status"]).count("completed")
-    except Exception:
-        return 0
-end = time.time() + 600
-while time.time() < end:
-    d = done()
-    if d >= 1:
-        try:
-            with h5py.File(f"k.runs/run{d:04d}.h5", "r", swmr=True) as r:
-                slots = r["run/checkpoint"][:, :3]  # magic, sequence, rows
-            if any(0 < s[2] <= 32 for s in slots if s[0] != 0) and done() == d:
-                sys.exit(0)
-        except Exception:
-            pass
-    time.sleep(0.01)
-sys.exit(1)
-PY
+  wait_inside_a_later_point || { echo "FAIL: SIG$sig: no point after the first wrote an early checkpoint"; exit 1; }
   kill -$sig "$pid"
   set +e
   wait "$pid"
@@ -117,8 +121,12 @@ if [ "$mpi" = 1 ]; then  # a worker rank killed: OpenMPI ends the job; the rerun
   rm -rf k.h5 k.runs
   OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -n 3 --oversubscribe "$rfem" sweep k.toml -q > /dev/null 2>&1 &
   pid=$!
-  for i in $(seq 1 6000); do [ "$(completed k.h5)" -ge 1 ] && break; sleep 0.05; done
-  worker=$(pgrep -f "^$rfem sweep k.toml" | tail -1)
+  wait_inside_a_later_point || { echo "FAIL: killed rank: no point after the first wrote an early checkpoint"; exit 1; }
+  worker=""
+  for p in $(pgrep -f "^$rfem sweep k.toml"); do  # (a worker: rank 0 runs no point)
+    [ "$(tr '\0' '\n' < /proc/$p/environ 2>/dev/null | sed -n 's/^OMPI_COMM_WORLD_RANK=//p')" = 1 ] && worker=$p
+  done
+  [ -n "$worker" ] || { echo "FAIL: killed rank: no rank 1 found"; exit 1; }
   kill -KILL "$worker"
   set +e
   wait "$pid"
