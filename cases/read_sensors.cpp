@@ -12,6 +12,7 @@ const char* to_string(SensorSpec::Kind k) {
     case SensorSpec::Kind::Torque: return "torque";
     case SensorSpec::Kind::Tip: return "tip";
     case SensorSpec::Kind::Strain: return "strain";
+    case SensorSpec::Kind::Imu: return "imu";
   }
   return "?";
 }
@@ -51,8 +52,8 @@ std::vector<SensorSpec> read_sensors(const Reader& r, const toml::table& root, c
         list += (list.empty() ? "" : ", ") + j.name;
       }
       if (!known) r.fail(t.get("joint"), p + ".joint", "no joint named '" + s.joint + "' (joints: " + list + ")");
-    } else if (kind == "tip" || kind == "strain") {
-      s.kind = kind == "tip" ? SensorSpec::Kind::Tip : SensorSpec::Kind::Strain;
+    } else if (kind == "tip" || kind == "strain" || kind == "imu") {
+      s.kind = kind == "tip" ? SensorSpec::Kind::Tip : kind == "strain" ? SensorSpec::Kind::Strain : SensorSpec::Kind::Imu;
       s.link = c.links.size() == 1 && !t.get("link") ? c.links[0].name : r.string(t, p, "link");
       keys.insert("link");
       const int l = c.link_index(s.link);
@@ -62,14 +63,24 @@ std::vector<SensorSpec> read_sensors(const Reader& r, const toml::table& root, c
         r.fail(t.get("link") ? t.get("link") : e, p + ".link",
                "no flexible link named '" + s.link + "'" + (list.empty() ? " (the case has none)" : " (links: " + list + ")"));
       }
+      const double L = c.links[static_cast<size_t>(l)].link.total_length();
       if (s.kind == SensorSpec::Kind::Tip) {
-        keys.insert("quantity");
+        keys.insert({"quantity", "frame"});
         s.quantity = r.string(t, p, "quantity", "deflection");
-        if (s.quantity != "deflection" && s.quantity != "position")
-          r.fail(t.get("quantity"), p + ".quantity", "\"deflection\" (u1, u2, theta in the link's frame) or \"position\" (x, y, z in {0})");
+        if (s.quantity != "deflection" && s.quantity != "position" && s.quantity != "velocity" && s.quantity != "acceleration")
+          r.fail(t.get("quantity"), p + ".quantity",
+                 "\"deflection\" (u1, u2, theta in the link's frame), \"position\", \"velocity\" or \"acceleration\" (got \"" + s.quantity + "\")");
+        if (s.quantity == "deflection" && t.get("frame"))
+          r.fail(t.get("frame"), p + ".frame", "a deflection is in the link's frame already (frame is for position, velocity, acceleration)");
+        s.frame = r.string(t, p, "frame", "world");
+        if (s.frame != "world" && s.frame != "link")
+          r.fail(t.get("frame"), p + ".frame", "\"world\" (the axes of {0}) or \"link\" (of the link's frame {r}) (got \"" + s.frame + "\")");
+      } else if (s.kind == SensorSpec::Kind::Imu) {
+        keys.insert("at");
+        s.at = r.non_negative(t, p, "at", L);
+        if (s.at > L) r.fail(t.get("at"), p + ".at", "beyond the link's length " + Reader::fmt(L) + " m");
       } else {
         keys.insert({"at", "face", "distance"});
-        const double L = c.links[static_cast<size_t>(l)].link.total_length();
         s.at = r.non_negative(t, p, "at", 0.0);
         if (s.at > L) r.fail(t.get("at"), p + ".at", "beyond the link's length " + Reader::fmt(L) + " m");
         const std::string face = r.string(t, p, "face", "z");
@@ -80,7 +91,7 @@ std::vector<SensorSpec> read_sensors(const Reader& r, const toml::table& root, c
         if (!t.get("distance")) r.fail(e, p + ".distance", "missing: the gauge's distance from the elastic axis [m]");
       }
     } else {
-      r.fail(t.get("kind"), p + ".kind", "\"encoder\", \"torque\", \"tip\" or \"strain\" (got \"" + kind + "\")");
+      r.fail(t.get("kind"), p + ".kind", "\"encoder\", \"torque\", \"tip\", \"strain\" or \"imu\" (got \"" + kind + "\")");
     }
     r.check_keys(t, p, keys);
     s.noise = r.non_negative(t, p, "noise", 0.0);

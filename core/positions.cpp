@@ -84,6 +84,43 @@ std::vector<double> axis_stations(const Model& model, int l) {
   return s;
 }
 
+PointMotion point_motion(const Model& model, int l, double s, const VecX& q, const VecX& v, const VecX& a) {
+  RFEM_CHECK_INDEX(l, model.links.size(), "link");
+  RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
+  RFEM_CHECK_ARGUMENT_SIZE(v.size(), model.dof(), "v");
+  RFEM_CHECK_ARGUMENT_SIZE(a.size(), model.dof(), "a");
+  BaseKinematics bk;
+  base_kinematics(model, q, v, a, bk);
+  const LinkFrame& f = bk.frame[l];
+  const MountedLink& L = model.links[l];
+  // The point and its body in {r}: position, velocity and acceleration relative to {r}, the body's
+  // rotation and its rate (all zero for a point rigid with {r}).
+  Vec3 p = Vec3(s, 0.0, 0.0), pd = Vec3::Zero(), pdd = Vec3::Zero();
+  Mat3 R = Mat3::Identity(), Rd = Mat3::Zero();
+  if (const int k = rfe_at(L.d, s); k >= 0) {
+    const int i = model.rfe_index(l, k);
+    DeformationTransform d;
+    deformation_transform(q.segment<6>(i), d, true);
+    const Vec4 eta(s - L.d.rfes[k].centre[0], -L.d.rfes[k].centre[1], -L.d.rfes[k].centre[2], 1.0);
+    const Mat34 Dd = d_dot(d, v.segment<6>(i)), Ddd = d_ddot(d, v.segment<6>(i), a.segment<6>(i));
+    p = L.d.rfes[k].centre + d.D.topRows<3>() * eta;
+    pd = Dd * eta;
+    pdd = Ddd * eta;
+    R = d.D.topLeftCorner<3, 3>();
+    Rd = Dd.leftCols<3>();
+  }
+  const Mat3 B = f.B0.topLeftCorner<3, 3>(), Bd = f.B0d.topLeftCorner<3, 3>(), Bdd = f.B0dd.topLeftCorner<3, 3>();
+  PointMotion m;
+  m.frame = f.B0;
+  m.position = B * p + f.B0.topRightCorner<3, 1>();
+  m.velocity = Bd * p + f.B0d.topRightCorner<3, 1>() + B * pd;
+  m.acceleration = Bdd * p + f.B0dd.topRightCorner<3, 1>() + 2.0 * Bd * pd + B * pdd;
+  m.rotation = B * R;
+  const Mat3 W = (Bd * R + B * Rd) * m.rotation.transpose();  // [ω×]
+  m.angular_velocity = Vec3(W(2, 1) - W(1, 2), W(0, 2) - W(2, 0), W(1, 0) - W(0, 1)) / 2.0;
+  return m;
+}
+
 Vec3 tip_position(const Model& model, int l, const VecX& q) {
   RFEM_CHECK_INDEX(l, model.links.size(), "link");
   return point_position(model, l, model.links[l].d.length, q);

@@ -24,6 +24,18 @@ void axis_points(const Model& model, int l, const std::vector<double>& s, const 
                  std::vector<Vec3>& deflection, std::vector<Mat3>* rotation = nullptr);
 /// The stations axis_points draws a link at: its start, every rfe's mass centre, its free end.
 std::vector<double> axis_stations(const Model& model, int l);
+/// How a point on a link's elastic axis moves (in {0}), and the body it moves with.
+struct PointMotion {
+  Vec3 position, velocity, acceleration;  ///< of the point, in {0} [m, m/s, m/s²]
+  Mat3 rotation;                          ///< from the body's frame to {0}
+  Vec3 angular_velocity;                  ///< of the body, in {0} [rad/s]
+  Mat4 frame;                             ///< the link's frame {r}: its pose in {0}
+};
+/// The point at s along link l's elastic axis at full coordinates q, rates v and accelerations a
+/// (each of model.dof()): with T the pose of the body it moves with (B0 for a rigid link or rfe_0's
+/// span, B0 D_k with D_k the rfe's deformation transform [2.4] otherwise), p = T η,
+/// ṗ = Ṫ η, p̈ = T̈ η and [ω×] = Ṙ Rᵀ (docs/formulation.md §3).
+PointMotion point_motion(const Model& model, int l, double s, const VecX& q, const VecX& v, const VecX& a);
 /// Position of link l's free end (on the elastic axis) in the inertial frame {0}.
 Vec3 tip_position(const Model& model, int l, const VecX& q);
 /// Origin of every joint's frame (where the body it moves is placed) in {0}.

@@ -126,7 +126,7 @@ void RunBook::sample(const OutputSample& x) {
   validity_->check_joints(x.q, x.v, x.tau, x.t);
   if (sensors_) {  // (their own random stream: the same readings whatever a controller asks)
     s.sensors.data.push_back(x.t);
-    sensors_->read(x.q, x.v, x.tau, s.sensors.data, 1);
+    sensors_->read(x.q, x.v, x.a, x.tau, s.sensors.data, 1);
     ++s.sensors.rows;
   }
   const double bal = x.energy_balance();

@@ -48,6 +48,7 @@ int SensorBank::width(size_t i) const {
   switch (sensors_[i].spec.kind) {
     case SensorSpec::Kind::Encoder: return 2;
     case SensorSpec::Kind::Tip: return 3;
+    case SensorSpec::Kind::Imu: return 6;
     default: return 1;
   }
 }
@@ -59,9 +60,10 @@ std::vector<std::string> SensorBank::columns() const {
     switch (r.spec.kind) {
       case SensorSpec::Kind::Encoder: c.insert(c.end(), {n + "/q", n + "/qd"}); break;
       case SensorSpec::Kind::Tip:
-        if (r.spec.quantity == "position") c.insert(c.end(), {n + "/x", n + "/y", n + "/z"});
-        else c.insert(c.end(), {n + "/u1", n + "/u2", n + "/theta"});
+        if (r.spec.quantity == "deflection") c.insert(c.end(), {n + "/u1", n + "/u2", n + "/theta"});
+        else c.insert(c.end(), {n + "/x", n + "/y", n + "/z"});
         break;
+      case SensorSpec::Kind::Imu: c.insert(c.end(), {n + "/wx", n + "/wy", n + "/wz", n + "/fx", n + "/fy", n + "/fz"}); break;
       default: c.push_back(n);
     }
   }
@@ -75,17 +77,20 @@ std::vector<std::string> SensorBank::units() const {
     switch (r.spec.kind) {
       case SensorSpec::Kind::Encoder: u.insert(u.end(), {prismatic ? "m" : "rad", prismatic ? "m/s" : "rad/s"}); break;
       case SensorSpec::Kind::Torque: u.push_back(prismatic ? "N" : "N m"); break;
-      case SensorSpec::Kind::Tip:
-        if (r.spec.quantity == "position") u.insert(u.end(), {"m", "m", "m"});
-        else u.insert(u.end(), {"m", "m", "rad"});
+      case SensorSpec::Kind::Tip: {
+        const std::string& k = r.spec.quantity;
+        if (k == "deflection") u.insert(u.end(), {"m", "m", "rad"});
+        else u.insert(u.end(), 3, k == "position" ? "m" : k == "velocity" ? "m/s" : "m/s2");
         break;
+      }
       case SensorSpec::Kind::Strain: u.push_back("1"); break;
+      case SensorSpec::Kind::Imu: u.insert(u.end(), {"rad/s", "rad/s", "rad/s", "m/s2", "m/s2", "m/s2"}); break;
     }
   }
   return u;
 }
 
-void SensorBank::read(const VecX& q, const VecX& v, const VecX& tau, std::vector<double>& out, int stream) {
+void SensorBank::read(const VecX& q, const VecX& v, const VecX& a, const VecX& tau, std::vector<double>& out, int stream) {
   for (Resolved& r : sensors_) {
     const size_t first = out.size();
     switch (r.spec.kind) {
@@ -95,13 +100,27 @@ void SensorBank::read(const VecX& q, const VecX& v, const VecX& tau, std::vector
         break;
       case SensorSpec::Kind::Torque: out.push_back(tau[r.joint]); break;
       case SensorSpec::Kind::Tip: {
-        if (r.spec.quantity == "position") {
-          const Vec3 p = tip_position(model_, r.link, q);
-          out.insert(out.end(), {p[0], p[1], p[2]});
-        } else {
+        if (r.spec.quantity == "deflection") {
           const Vec3 u = tip_deflection(model_, r.link, q);
           out.insert(out.end(), {u[0], u[1], u[2]});
+          break;
         }
+        const PointMotion m = point_motion(model_, r.link, model_.links[static_cast<size_t>(r.link)].d.length, q, v, a);
+        const bool link = r.spec.frame == "link";
+        const Mat3 axes = link ? Mat3(m.frame.topLeftCorner<3, 3>().transpose()) : Mat3::Identity();
+        Vec3 x = r.spec.quantity == "position" ? m.position : r.spec.quantity == "velocity" ? m.velocity : m.acceleration;
+        if (link && r.spec.quantity == "position") x -= m.frame.topRightCorner<3, 1>();
+        x = axes * x;
+        out.insert(out.end(), {x[0], x[1], x[2]});
+        break;
+      }
+      case SensorSpec::Kind::Imu: {
+        // Strapdown: the body's rate and the specific force a − g, both in the body's axes (at rest
+        // under gravity an accelerometer reads +g upwards).
+        const PointMotion m = point_motion(model_, r.link, r.spec.at, q, v, a);
+        const Vec3 w = m.rotation.transpose() * m.angular_velocity;
+        const Vec3 f = m.rotation.transpose() * (m.acceleration - Vec3(0.0, 0.0, -model_.gravity));
+        out.insert(out.end(), {w[0], w[1], w[2], f[0], f[1], f[2]});
         break;
       }
       case SensorSpec::Kind::Strain: {

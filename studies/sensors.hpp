@@ -18,15 +18,15 @@ class SensorBank {
   bool empty() const { return sensors_.empty(); }
   size_t size() const { return sensors_.size(); }
   const SensorSpec& spec(size_t i) const { return sensors_[i].spec; }
-  /// Values of sensor i (1 for a torque or a strain, 2 for an encoder, 3 for a tip).
+  /// Values of sensor i (1 for a torque or a strain, 2 for an encoder, 3 for a tip, 6 for an IMU).
   int width(size_t i) const;
   /// Every value's column name ("NAME", or "NAME/q", "NAME/qd", "NAME/u1" …) and unit.
   std::vector<std::string> columns() const;
   std::vector<std::string> units() const;
-  /// Every sensor's values at a state (full q, v and the joints' torques), appended to `out`:
+  /// Every sensor's values at a state (full q, v, a and the joints' torques), appended to `out`:
   /// exact, or as measured (noise, then quantisation) from the random streams of `stream`
   /// (0: the controller's snapshots, 1: the recorded outputs), which advance.
-  void read(const VecX& q, const VecX& v, const VecX& tau, std::vector<double>& out, int stream = -1);
+  void read(const VecX& q, const VecX& v, const VecX& a, const VecX& tau, std::vector<double>& out, int stream = -1);
 
  private:
   struct Resolved {

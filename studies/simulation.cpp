@@ -269,14 +269,16 @@ double Simulation::t_end() const { return impl_->o.t_end; }
 
 namespace {
 // Every coordinate (rates: every rate) from the unknowns and the prescribed joints' laws at t.
+// The full coordinates (order 0), rates (1) or accelerations (2): the unknowns' and the prescribed
+// joints' motion at t.
 VecX full(const Model& model, const EquationsOfMotion& eq, const std::vector<JointInput>& inputs, const VecX& unknowns,
-          double t, bool rates) {
+          double t, int order) {
   VecX x = VecX::Zero(model.dof());
   for (int i = 0; i < eq.unknowns(); ++i) x[eq.unknown_index(i)] = unknowns[i];
   for (int j = 0; j < model.m(); ++j)
     if (inputs[j].prescribed()) {
       const MotionSample s = inputs[j].motion->at(t);
-      x[model.joint_index(j)] = rates ? s.qd : s.q;
+      x[model.joint_index(j)] = order == 0 ? s.q : order == 1 ? s.qd : s.qdd;
     }
   return x;
 }
@@ -285,13 +287,13 @@ VecX full(const Model& model, const EquationsOfMotion& eq, const std::vector<Joi
 VecX Simulation::q() const {
   const Impl& m = *impl_;
   const IntegratorState x = m.stepper->state();
-  return full(*m.model, *m.eq, m.inputs, x.q, x.t, false);
+  return full(*m.model, *m.eq, m.inputs, x.q, x.t, 0);
 }
 
 VecX Simulation::v() const {
   const Impl& m = *impl_;
   const IntegratorState x = m.stepper->state();
-  return full(*m.model, *m.eq, m.inputs, x.v, x.t, true);
+  return full(*m.model, *m.eq, m.inputs, x.v, x.t, 1);
 }
 
 std::vector<std::string> Simulation::coordinate_names() const {
@@ -369,7 +371,7 @@ Snapshot Simulation::snapshot() {
   // motion); a snapshot needs no energies or momentum (an output sample's extra passes).
   m.scratch.resize(m.eq->unknowns());
   m.eq->residual(x.t, x.q.data(), x.v.data(), x.a.data(), m.scratch.data());
-  const VecX q = full(*m.model, *m.eq, m.inputs, x.q, x.t, false), v = full(*m.model, *m.eq, m.inputs, x.v, x.t, true);
+  const VecX q = full(*m.model, *m.eq, m.inputs, x.q, x.t, 0), v = full(*m.model, *m.eq, m.inputs, x.v, x.t, 1);
   Snapshot y;
   y.t = x.t;
   y.joint_q = m.model->joint_coords(q);
@@ -381,7 +383,7 @@ Snapshot Simulation::snapshot() {
   }
   if (m.sensors) {
     std::vector<double> values;
-    m.sensors->read(q, v, y.joint_tau, values, 0);
+    m.sensors->read(q, v, full(*m.model, *m.eq, m.inputs, x.a, x.t, 2), y.joint_tau, values, 0);
     size_t k = 0;
     for (size_t i = 0; i < m.sensors->size(); ++i) {
       const auto w = static_cast<size_t>(m.sensors->width(i));

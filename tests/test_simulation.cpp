@@ -306,6 +306,18 @@ joint = "hub"
 [[sensors]]
 name = "tip"
 kind = "tip"
+[[sensors]]
+name = "imu"
+kind = "imu"
+[[sensors]]
+name = "tip_v"
+kind = "tip"
+quantity = "velocity"
+[[sensors]]
+name = "tip_a"
+kind = "tip"
+quantity = "acceleration"
+frame = "link"
 [simulation]
 t_end = 0.02
 output_dt = 0.01
@@ -318,12 +330,26 @@ output_dt = 0.01
   const double exact = M * 0.01 / (7.0e10 * 2.0e-7);
   Simulation sim(cs, one_thread());
   const Snapshot y = sim.snapshot();
-  ASSERT_EQ(y.sensors.size(), 5u);
+  ASSERT_EQ(y.sensors.size(), 8u);
   EXPECT_EQ(y.sensors[0].first, "gauge");
   EXPECT_NEAR(y.sensors[0].second.at(0), exact, 1e-4 * exact);
   EXPECT_LT(std::abs(y.sensors[1].second.at(0)), 1e-6 * exact);  // no bending about z
   EXPECT_EQ(y.sensors[3].second.size(), 2u);                     // encoder: q, q̇
   EXPECT_NEAR(y.sensors[4].second.at(1), y.tip_deflection[0][1], 1e-15);
+  // An IMU on the tip at rest reads no rate and the specific force +g upwards in the axes of the
+  // tip rfe, turned by its slope φ2 about y: (−g sin φ2, 0, g cos φ2), to the equilibrium's residual
+  // acceleration (the static solution's 1e-10 relative tolerance); the tip neither moves nor accelerates.
+  const VecX q = sim.q();
+  const double slope = q[model.rfe_index(0, model.links[0].n() - 1) + 4];
+  EXPECT_GT(slope, 1e-5);  // (bent down: x turns towards −z, a positive rotation about y)
+  const std::vector<double>& imu = y.sensors[5].second;
+  ASSERT_EQ(imu.size(), 6u);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(imu[static_cast<size_t>(k)], 0.0);
+  EXPECT_NEAR(imu[3], -9.81 * std::sin(slope), 1e-8);
+  EXPECT_NEAR(imu[4], 0.0, 1e-8);
+  EXPECT_NEAR(imu[5], 9.81 * std::cos(slope), 1e-8);
+  for (int s = 6; s < 8; ++s)
+    for (double x : y.sensors[static_cast<size_t>(s)].second) EXPECT_NEAR(x, 0.0, 1e-8);
   // Noise and resolution: multiples of the quantum, within 6σ of the exact value, the same again
   // from the same seed.
   const double noisy = y.sensors[2].second.at(0);
