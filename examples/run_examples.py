@@ -2,7 +2,7 @@
 """Runs the examples and compares what they print with their answer files (answers/NAME.out),
 SUNDIALS' habit: a changed number is a changed result.
 
-    /usr/bin/python3 examples/run_examples.py [--pythonpath build/python] [--cpp BUILD/ex6_library]
+    /usr/bin/python3 examples/run_examples.py [--pythonpath build/python] [--cpp BUILD_DIR]
                                               [--only ex1,ex3] [--update]
 
 Text must match exactly; numbers to a relative 1e-5 (or 1e-12 absolute). Why 1e-5: builds for
@@ -25,6 +25,7 @@ NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?|[-+]?\b(?:nan
 RTOL, ATOL = 1e-5, 1e-12
 PYTHON = ["ex1_paper_figures", "ex2_refinement", "ex3_parameter_study", "ex4_modes_rotation", "ex5_two_link_pd",
           "ex7_urdf_arm", "ex8_control_loop"]
+CPP = ["ex6_library", "ex12_controller"]
 
 
 def same(expected, got):
@@ -49,7 +50,7 @@ def same(expected, got):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--pythonpath", help="directory holding the rfem package (default: the installed one)")
-    ap.add_argument("--cpp", help="the built ex6_library (Example 6, against the installed library)")
+    ap.add_argument("--cpp", help="where examples/cpp was built (Examples 6 and 12, against the installed library)")
     ap.add_argument("--only", help="comma-separated example names (ex1, ex6, …)")
     ap.add_argument("--update", action="store_true", help="rewrite the answer files")
     args = ap.parse_args()
@@ -58,7 +59,9 @@ def main():
         env["PYTHONPATH"] = os.path.abspath(args.pythonpath)
     jobs = [(name, [sys.executable, os.path.join(HERE, name + ".py")]) for name in PYTHON]
     if args.cpp:
-        jobs.append(("ex6_library", [os.path.abspath(args.cpp), os.path.join(HERE, "..", "cases")]))
+        built = os.path.abspath(args.cpp if os.path.isdir(args.cpp) else os.path.dirname(args.cpp))
+        for name in CPP:
+            jobs.append((name, [os.path.join(built, name), os.path.join(HERE, "..", "cases")]))
     if args.only:
         wanted = args.only.split(",")
         jobs = [(n, c) for n, c in jobs if any(n == w or n.startswith(w + "_") for w in wanted)]

@@ -40,6 +40,10 @@ class HeldLaw : public TorqueLaw {
   double stiffness() const override { return mode == kHeldTorque ? 0.0 : base_->stiffness(); }
   double damping() const override { return mode == kHeldTorque ? 0.0 : base_->damping(); }
   std::vector<double> breakpoints() const override { return base_->breakpoints(); }
+  // A digital law (pd with sample_time) keeps sampling under a held value: released, it goes on
+  // from its own last sample, as the controller it models would.
+  double sample_time() const override { return base_->sample_time(); }
+  void sample(double t, double q, double v) override { base_->sample(t, q, v); }
   bool feedback() const { return base_->stiffness() > 0 || base_->damping() > 0; }
   int mode = kHeldNone;
   double tau = 0.0, q_ref = 0.0, v_ref = 0.0, tau_ff = 0.0;

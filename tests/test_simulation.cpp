@@ -368,7 +368,8 @@ output_dt = 0.01
 
 TEST(Simulation, TheBuiltInDigitalPdIsTheSameLawAsAControllerBitForBit) {
   // `pd` with sample_time: the case's law sampled and held by the integrator itself; the same law
-  // written as a controller at the same rate takes the same steps on the same values.
+  // written as a controller at the same rate takes the same steps on the same values; a stepped
+  // simulation of the case samples it too (chunks end steps elsewhere: to the tolerances).
   const Case continuous = pd_hub();
   const Case digital = with_overrides(continuous, {"joints.0.input.sample_time=2e-3"});
   RunRequest rq;
@@ -384,6 +385,14 @@ TEST(Simulation, TheBuiltInDigitalPdIsTheSameLawAsAControllerBitForBit) {
   EXPECT_EQ(builtin.stats.steps, loop.stats.steps);
   EXPECT_EQ(series(builtin, "joint_q").data, series(loop, "joint_q").data);
   EXPECT_EQ(series(builtin, "tip_deflection").data, series(loop, "tip_deflection").data);
+  // A simulation of the digital case, stepped in chunks that are not samples, samples the same.
+  Simulation sim(digital, one_thread());
+  for (double t = 0.37; t < sim.t_end(); t += 0.37) sim.advance(t);
+  sim.advance(sim.t_end());
+  const RunResult stepped = sim.finish();
+  // (to the integrator's relative tolerance; a law that did not sample leaves the hub at rest)
+  const double q_end = series(builtin, "joint_q").data.back();
+  EXPECT_NEAR(series(stepped, "joint_q").data.back(), q_end, 1e-6 * std::abs(q_end));
   // A delay of one sample is another law (later by Ts), and a sample time with BDF is refused.
   const RunResult late = run_case(with_overrides(digital, {"joints.0.input.delay=1"}), rq).at(0);
   EXPECT_NE(series(late, "joint_q").data, series(builtin, "joint_q").data);
