@@ -229,6 +229,9 @@ class SampledTorque : public TorqueLaw {
   double at(double, double, double) const override { return held_; }
   double sample_time() const override { return ts_; }
   void sample(double t, double q, double v) override {
+    // Once per sample time: a run going on from a saved state stands at a sample it has taken.
+    if (t <= last_ + 1e-12 * std::max(1.0, std::abs(t))) return;
+    last_ = t;
     const double u = law_->at(t, q, v);
     if (t <= 0.0) {  // a run's first sample: the controller at rest before it
       pending_.clear();
@@ -240,11 +243,25 @@ class SampledTorque : public TorqueLaw {
       pending_.pop_front();
     }
   }
+  std::vector<double> memory() const override {
+    std::vector<double> m = {last_, held_};
+    m.insert(m.end(), pending_.begin(), pending_.end());
+    return m;
+  }
+  void restore(const std::vector<double>& m) override {
+    if (m.size() < 2 || m.size() > 2 + static_cast<size_t>(delay_))
+      throw std::invalid_argument("a digital law's memory of " + std::to_string(m.size()) + " values does not fit its delay of " +
+                                  std::to_string(delay_) + " samples");
+    last_ = m[0];
+    held_ = m[1];
+    pending_.assign(m.begin() + 2, m.end());
+  }
 
  private:
   std::shared_ptr<TorqueLaw> law_;
   double ts_;
   int delay_;
+  double last_ = -INFINITY;  // the last sample's time
   double held_ = 0.0;
   std::deque<double> pending_;
 };

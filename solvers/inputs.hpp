@@ -39,6 +39,10 @@ class TorqueLaw {
   /// At a sample time t with the joint's q, v there (the integrator calls it, its steps ending at
   /// every sample): the law computes its next output.
   virtual void sample(double /*t*/, double /*q*/, double /*v*/) {}
+  /// What a law remembers between samples (a digital law: its last sample's time, the held value
+  /// and the outputs still delayed), for a saved state; restore() takes it back. Empty: nothing.
+  virtual std::vector<double> memory() const { return {}; }
+  virtual void restore(const std::vector<double>& /*memory*/) {}
 };
 
 /// Kane's deployment law (the dimensionally consistent form, docs/formulation.md §3):

@@ -18,7 +18,7 @@ namespace rfem {
 
 namespace {
 
-constexpr double kStateVersion = 1.0;
+constexpr double kStateVersion = 2.0;  // (1: no memory of the laws; still read)
 // What a joint holds (SimulationState::drives: the mode, then τ, q_ref, q̇_ref, τ_ff).
 constexpr int kHeldNone = 0, kHeldTorque = 1, kHeldReference = 2, kDriveValues = 5;
 
@@ -44,6 +44,8 @@ class HeldLaw : public TorqueLaw {
   // from its own last sample, as the controller it models would.
   double sample_time() const override { return base_->sample_time(); }
   void sample(double t, double q, double v) override { base_->sample(t, q, v); }
+  std::vector<double> memory() const override { return base_->memory(); }
+  void restore(const std::vector<double>& m) override { base_->restore(m); }
   bool feedback() const { return base_->stiffness() > 0 || base_->damping() > 0; }
   int mode = kHeldNone;
   double tau = 0.0, q_ref = 0.0, v_ref = 0.0, tau_ff = 0.0;
@@ -59,20 +61,38 @@ const char* kAxisNames[6] = {"x1", "x2", "x3", "phi1", "phi2", "phi3"};
 std::vector<double> SimulationState::pack() const {
   std::vector<double> x = {kStateVersion, static_cast<double>(drives.size())};
   x.insert(x.end(), drives.begin(), drives.end());
+  x.push_back(static_cast<double>(memory.size()));
+  for (const std::vector<double>& m : memory) {
+    x.push_back(static_cast<double>(m.size()));
+    x.insert(x.end(), m.begin(), m.end());
+  }
   const std::vector<double> i = integrator.pack();
   x.insert(x.end(), i.begin(), i.end());
   return x;
 }
 
 SimulationState SimulationState::unpack(const std::string& model, const std::vector<double>& x) {
-  if (x.size() < 2 || x[0] != kStateVersion || !(x[1] >= 0) || x[1] != std::floor(x[1]) ||
-      x.size() < 2 + static_cast<size_t>(x[1]))
-    throw std::invalid_argument("not a simulation state of this version of rfem");
+  const auto bad = [] { return std::invalid_argument("not a simulation state of this version of rfem"); };
+  // A count at x[i]: a whole number with that many values after it.
+  const auto count = [&](size_t i) {
+    if (i >= x.size() || !(x[i] >= 0) || x[i] != std::floor(x[i]) || x[i] > static_cast<double>(x.size() - i - 1)) throw bad();
+    return static_cast<size_t>(x[i]);
+  };
+  if (x.size() < 2 || (x[0] != kStateVersion && x[0] != 1.0)) throw bad();
   SimulationState s;
   s.model = model;
-  const size_t nd = static_cast<size_t>(x[1]);
+  const size_t nd = count(1);
   s.drives.assign(x.begin() + 2, x.begin() + 2 + static_cast<long>(nd));
-  s.integrator = IntegratorState::unpack(std::vector<double>(x.begin() + 2 + static_cast<long>(nd), x.end()), -1);
+  size_t i = 2 + nd;
+  if (x[0] == kStateVersion) {
+    s.memory.resize(count(i++));
+    for (std::vector<double>& m : s.memory) {
+      const size_t k = count(i++);
+      m.assign(x.begin() + static_cast<long>(i), x.begin() + static_cast<long>(i + k));
+      i += k;
+    }
+  }
+  s.integrator = IntegratorState::unpack(std::vector<double>(x.begin() + static_cast<long>(i), x.end()), -1);
   return s;
 }
 
@@ -169,6 +189,13 @@ struct Simulation::Impl {
       held[j]->tau_ff = x[4];
     }
   }
+  void apply_memory(const std::vector<std::vector<double>>& memory) {
+    if (memory.empty()) return;  // (a state of version 1: the laws start afresh)
+    if (memory.size() != inputs.size()) throw std::invalid_argument("the state's laws do not fit this model");
+    for (size_t j = 0; j < inputs.size(); ++j)
+      if (inputs[j].torque) inputs[j].torque->restore(memory[j]);
+      else if (!memory[j].empty()) throw std::invalid_argument("the state's laws do not fit this model");
+  }
   void bring_inputs_up_to_date() {
     if (!changed || status.kind != RunStatus::Kind::Running) return;
     stepper->inputs_changed();
@@ -232,7 +259,10 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
   m.book = std::make_unique<RunBook>("run", m.model, m.inputs, cs, m.rq, m.o);
   if (!cs.sensors.empty()) m.sensors = std::make_unique<SensorBank>(cs, *m.model);
   m.eq = std::make_unique<EquationsOfMotion>(m.model, m.inputs, m.o.forces, m.rq.stop, m.o.linear_solver, m.o.parallel);
-  if (from) m.apply_drives(from->drives);  // (after the equations took the case laws' gains for Newton)
+  if (from) {
+    m.apply_drives(from->drives);
+    m.apply_memory(from->memory);
+  }  // (after the equations took the case laws' gains for Newton)
   if (m.eq->unknowns() == 0)
     throw CaseError(cs.path + ": joints: every joint follows a prescribed motion and there is no flexible link: nothing to step "
                               "(rfem run computes its torques)");
@@ -414,6 +444,7 @@ SimulationState Simulation::state() const {
       d[3] = h->v_ref;
       d[4] = h->tau_ff;
     }
+  for (const JointInput& in : m.inputs) s.memory.push_back(in.torque ? in.torque->memory() : std::vector<double>{});
   return s;
 }
 

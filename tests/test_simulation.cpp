@@ -162,6 +162,31 @@ TEST(Simulation, StartedFromAStateContinuesTheOriginalBitForBit) {
   EXPECT_EQ(max_difference(series(a, "tip_deflection"), series(a, "time"), series(b, "tip_deflection"), tb, tb.rows - 1), 0.0);
 }
 
+TEST(Simulation, AStateCarriesADigitalLawsHeldAndDelayedValues) {
+  // A digital PD with a delay of two samples remembers three outputs at any time: a state saved
+  // at a sample (0.2 s) and between samples (0.301 s) carries them (through its file), and the
+  // simulation started from it continues the original bit for bit. Without that memory the held
+  // torque would restart from zero for two samples and the runs part.
+  const Case cs = with_overrides(pd_hub(), {"joints.0.input.sample_time=2e-3", "joints.0.input.delay=2", "simulation.t_end=0.5"});
+  for (double t_save : {0.2, 0.301}) {
+    Simulation first(cs, one_thread());
+    first.advance(t_save);
+    const SimulationState saved = first.state();
+    ASSERT_EQ(saved.memory.size(), 1u);
+    EXPECT_EQ(saved.memory[0].size(), 4u);  // last sample's time, held, two delayed
+    const std::string path = (std::filesystem::temp_directory_path() / "rfem_test_digital_state.h5").string();
+    save_state(saved, path);
+    first.advance(0.5);
+    SimulationOptions o = one_thread();
+    o.state = std::make_shared<const SimulationState>(load_state(path));
+    std::filesystem::remove(path);
+    Simulation second(cs, o);
+    second.advance(0.5);
+    EXPECT_EQ(first.q(), second.q()) << "saved at " << t_save;
+    EXPECT_EQ(first.v(), second.v()) << "saved at " << t_save;
+  }
+}
+
 TEST(Simulation, AHeldTorqueEqualToTheCaseLawChangesNothing) {
   const Case cs = hub(0.3);
   Simulation a(cs, one_thread()), b(cs, one_thread()), c(cs, one_thread());
