@@ -500,8 +500,8 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
       h = o.fixed_step > 0 ? o.fixed_step : (callers ? std::max(h, h_proposed) : h) * fac;
       if (o.max_step > 0) h = std::min(h, o.max_step);
       sample_due();
-      // (A digital law's held values are not in the integrator's state: no checkpoints to resume from.)
-      if (sampled.empty() && !emit.checkpoint([&] { return state(); })) return emit.failure();
+      // (A digital law's held values are the laws' own memory: the run's book checkpoints them.)
+      if (!emit.checkpoint([&] { return state(); })) return emit.failure();
     }
   } catch (const std::exception& e) {
     return fail(e.what());

@@ -122,6 +122,46 @@ TEST(Resume, PaperProcedureStoppedInItsKinematicRunEndsBitForBitAsUninterrupted)
   std::filesystem::remove(path);
 }
 
+TEST(Resume, ADigitalPdGoesOnFromItsHeldAndDelayedValues) {
+  // A digital PD with a delay of two samples (held values are the law's memory, not the
+  // integrator's): stopped at an output and resumed from its checkpoint, the run ends bit for bit
+  // as the uninterrupted one (it would not if the held or delayed torques restarted from zero).
+  const Case cs = read_case(test::source_path("cases/kane_hub_drive.toml"),
+                            {"link.n=6", "simulation.t_end=1.0", "simulation.output_dt=0.01",
+                             "joints.0.input={kind=\"pd\", reference={kind=\"spinup\", Omega=1.0, T=2.0}, kp=4.0e4, kd=1.2e4, "
+                             "sample_time=1e-3, delay=2}"});
+  RunRequest whole;
+  whole.threads = 1;
+  const RunResult ref = run_case(cs, whole).at(0);
+  ASSERT_TRUE(ref.completed()) << ref.status;
+  const std::string path = temp_file("digital.h5");
+  const auto model = model_of(cs, 6);
+  {
+    ResultsWriter file(path, describe(cs, "test_resume", "single", model->n(), 1, 6));
+    Hdf5Recorder recorder(file);
+    RunRequest rq;
+    rq.threads = 1;
+    rq.keep_series = false;
+    rq.checkpoint_interval = 1e-9;
+    StopAt stop(rq.stop, "run", 37);
+    rq.observers = {&recorder, &stop};
+    EXPECT_EQ(run_case(cs, model, joint_inputs(cs, {}), rq).at(0).status.kind, RunStatus::Kind::Interrupted);
+    file.close();
+  }
+  const ResumePlan plan = plan_resume(path);
+  ASSERT_EQ(plan.resume.count("run"), 1u);
+  RunRequest rq;
+  rq.threads = 1;
+  const RunResult rest = resume_case(plan, rq).at(0);
+  ASSERT_TRUE(rest.completed()) << rest.status;
+  EXPECT_EQ(ref.stats.steps, rest.stats.steps);
+  for (const std::string& name : {"joint_q", "joint_tau", "tip_deflection"}) {
+    const Table x = ref.series->table(name), y = rest.series->table(name);
+    EXPECT_TRUE(x.data == y.data) << name << " differs";
+  }
+  std::filesystem::remove(path);
+}
+
 TEST(Resume, IntegratorStateRoundTripsAndRefusesAnotherModel) {
   IntegratorState s;
   s.t = 1.25;
