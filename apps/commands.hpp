@@ -80,6 +80,8 @@ int run_view(const std::string& results, const std::vector<std::string>& runs);
 void print_json(const nlohmann::json& j);
 /// Prints "rfem: warning: …" on stderr.
 void print_warning(const std::string& w);
+/// One line on stderr; never throws (a broken stderr must not turn an error into an abort).
+void print_line(const std::string& line) noexcept;
 /// The case of the command line (--set applied), its plausibility warnings printed to stderr.
 Case read_checked_case(const Common& c);
 /// Refuses a run the machine's memory cannot hold (CaseError); before a run of kLargeRunRfes rfes

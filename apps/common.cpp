@@ -9,7 +9,15 @@ namespace rfem::app {
 
 void print_json(const nlohmann::json& j) { fmt::print("{}\n", j.dump(2)); }
 
-void print_warning(const std::string& w) { fmt::print(stderr, "rfem: warning: {}\n", w); }
+void print_warning(const std::string& w) { print_line("rfem: warning: " + w); }
+
+void print_line(const std::string& line) noexcept {
+  // (stderr gone or full: nothing else to tell, and the exit code still says what happened)
+  try {
+    fmt::print(stderr, "{}\n", line);
+  } catch (...) {
+  }
+}
 
 Case read_checked_case(const Common& c) {
   Case cs = read_case(c.case_path, c.overrides);

@@ -166,7 +166,7 @@ int main(int argc, char** argv) {
     bool known = false;
     for (const auto* sub : app.get_subcommands([](const CLI::App*) { return true; })) known |= sub->get_name() == w;
     if (!known) {
-      fmt::print(stderr, "rfem: error: unknown command '{}' (show, static, modes, run, refine, sweep, plot, view, animate; rfem --help)\n", w);
+      print_line(fmt::format("rfem: error: unknown command '{}' (show, static, modes, run, refine, sweep, plot, view, animate; rfem --help)", w));
       return 2;
     }
   }
@@ -183,7 +183,7 @@ int main(int argc, char** argv) {
     std::string what = e.what();
     for (char& ch : what)
       if (ch == '\n') ch = ' ';
-    fmt::print(stderr, "rfem: error: {} (rfem --help)\n", what);
+    print_line(fmt::format("rfem: error: {} (rfem --help)", what));
     return 2;
   }
   Eigen::setNbThreads(1);  // librfem parallelises itself (--threads goes to each call)
@@ -221,13 +221,13 @@ int main(int argc, char** argv) {
       return run_refine(common, ro, mo);
     }
   } catch (const rfem::CaseError& e) {
-    fmt::print(stderr, "rfem: error: {}\n", e.what());
+    print_line(fmt::format("rfem: error: {}", e.what()));
     return 2;
   } catch (const rfem::ResultsError& e) {  // a results file that cannot be made or written: the caller's path
-    fmt::print(stderr, "rfem: error: {}\n", e.what());
+    print_line(fmt::format("rfem: error: {}", e.what()));
     return 2;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "rfem: error: {}\n", e.what());
+    print_line(fmt::format("rfem: error: {}", e.what()));
     return 1;
   }
   return 0;

@@ -175,5 +175,10 @@ else bad "incomplete source: $(cat err.txt)"; fi
 if [ $? = 0 ] && grep -Eq "^rfem: note: n = 10000 rfes: about 4[0-9] MB of memory; one residual evaluation [0-9.e-]+ ms, .*s per step" err.txt
 then ok "large run estimated: $(cat err.txt)"; else bad "large-run note: $(cat err.txt)"; fi
 
+# 9. An error with nowhere to write it (stderr full) still exits 2, not an abort.
+"$rfem" run missing.toml 2> /dev/full
+code=$?
+[ $code = 2 ] && ok "error with a full stderr: exit 2" || bad "error with a full stderr: exit $code"
+
 [ $fail = 0 ] && echo "new user: all passed" || echo "new user: failures above"
 exit $fail
