@@ -309,6 +309,13 @@ PYBIND11_MODULE(_rfem, m) {
         return py::dict(py::arg("name") = i.name, py::arg("columns") = i.columns, py::arg("units") = i.units,
                         py::arg("description") = i.description);
       }, py::arg("name"), "Columns, units and description of series `name`.")
+      .def_property_readonly("sensors", [](const RunResult& r) {
+        py::array_t<double> a({static_cast<py::ssize_t>(r.sensors.rows), static_cast<py::ssize_t>(r.sensors.cols)});
+        std::copy(r.sensors.data.begin(), r.sensors.data.end(), a.mutable_data());
+        return a;
+      }, "the case's [[sensors]] at every output as measured: a row per output, `time` first (sensor_columns)")
+      .def_readonly("sensor_columns", &RunResult::sensor_columns, "the columns of `sensors` ('time', 'NAME', 'NAME/q', …)")
+      .def_readonly("sensor_units", &RunResult::sensor_units)
       .def("__repr__", [](const RunResult& r) {
         return "<rfem.Run " + r.name + ": " + r.status.to_string() + ", " + std::to_string(r.samples) + " outputs>";
       });
