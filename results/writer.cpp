@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <thread>
 #include <variant>
 
 #include "rfem/results/writer_impl.hpp"
@@ -62,8 +63,17 @@ ResultsWriter::ResultsWriter(const std::string& path, const FileDescription& d) 
   try {
     file_->require(kMargin);
     const h5::Handle fapl = latest_fapl();
-    file_->id = h5::file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl),
-                         path + ": cannot create results file (is the directory writable?)");
+    // A reader that opens the path between HDF5's creation of the file and its lock (a poller
+    // waiting for the file to appear) holds a shared lock for an instant: the creation then fails
+    // with EAGAIN, and is tried again for up to a second.
+    errno = 0;
+    hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    for (int k = 0; id < 0 && (errno == EAGAIN || errno == EWOULDBLOCK) && k < 100; ++k) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      errno = 0;
+      id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    }
+    file_->id = h5::file(id, path + ": cannot create results file (is the directory writable?)");
     created = true;
     file_->attribute("/", "rfem_version", std::string(version_string));
     file_->attribute("/", "build", std::string(build_description()));
