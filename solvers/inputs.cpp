@@ -268,6 +268,32 @@ class SampledTorque : public TorqueLaw {
 
 }  // namespace
 
+std::vector<double> pack_law_memory(const std::vector<JointInput>& inputs) {
+  std::vector<double> x;
+  bool any = false;
+  for (const JointInput& in : inputs) {
+    const std::vector<double> m = in.torque ? in.torque->memory() : std::vector<double>{};
+    x.push_back(static_cast<double>(m.size()));
+    x.insert(x.end(), m.begin(), m.end());
+    any |= !m.empty();
+  }
+  return any ? x : std::vector<double>{};
+}
+
+void restore_law_memory(const std::vector<JointInput>& inputs, const std::vector<double>& x) {
+  size_t i = 0;
+  for (const JointInput& in : inputs) {
+    if (i >= x.size() || !(x[i] >= 0) || x[i] != std::floor(x[i]) || x[i] > static_cast<double>(x.size() - i - 1))
+      throw std::invalid_argument("the laws' memory does not fit these joints");
+    const auto k = static_cast<size_t>(x[i++]);
+    const std::vector<double> m(x.begin() + static_cast<long>(i), x.begin() + static_cast<long>(i + k));
+    if (in.torque) in.torque->restore(m);
+    else if (k > 0) throw std::invalid_argument("the laws' memory does not fit these joints");
+    i += k;
+  }
+  if (i != x.size()) throw std::invalid_argument("the laws' memory does not fit these joints");
+}
+
 std::shared_ptr<TorqueLaw> sampled_law(std::shared_ptr<TorqueLaw> law, double sample_time, int delay) {
   return std::make_shared<SampledTorque>(std::move(law), sample_time, delay);
 }

@@ -88,4 +88,10 @@ struct JointInput {
   std::vector<double> breakpoints() const { return motion ? motion->breakpoints() : torque->breakpoints(); }
 };
 
+/// What the joints' laws remember (TorqueLaw::memory), as one vector: per joint its count, then its
+/// values (a prescribed joint: 0); empty when no law remembers anything.
+std::vector<double> pack_law_memory(const std::vector<JointInput>& inputs);
+/// Gives every law its memory back; std::invalid_argument for memory of other joints or laws.
+void restore_law_memory(const std::vector<JointInput>& inputs, const std::vector<double>& memory);
+
 }  // namespace rfem

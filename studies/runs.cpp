@@ -60,17 +60,14 @@ RunBook::RunBook(std::string name, std::shared_ptr<const Model> model, const std
   for (const MountedLink& L : model_->links) s.peaks.push_back({L.name});
   const RunInfo info{s.name, model_, o, input_kinds(inputs), cs.sim.flexible_every, o.parallel.max_threads(), checkpoint};
   for (RunObserver* obs : rq.observers) obs->begin(info);
-  for (const JointInput& in : inputs) laws_.push_back(in.torque);
+  inputs_ = inputs;
   if (checkpoint) {
     RFEM_CHECK_ARGUMENT(resumed != nullptr, "a checkpoint needs its unpacked state");
-    if (const std::vector<double>* x = resumed->find(kLawsKey)) {  // per joint: a count, then its memory
-      size_t i = 0;
-      for (const std::shared_ptr<TorqueLaw>& law : laws_) {
-        if (i >= x->size() || (*x)[i] < 0 || (*x)[i] > static_cast<double>(x->size() - i - 1))
-          throw std::invalid_argument("run " + s.name + ": its checkpoint's laws do not fit this model");
-        const auto k = static_cast<long>((*x)[i++]);
-        if (law) law->restore(std::vector<double>(x->begin() + static_cast<long>(i), x->begin() + static_cast<long>(i) + k));
-        i += static_cast<size_t>(k);
+    if (const std::vector<double>* x = resumed->find(kLawsKey)) {
+      try {
+        restore_law_memory(inputs_, *x);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument("run " + s.name + ": its checkpoint: " + e.what());
       }
     }
     for (RunObserver* obs : rq.observers)
@@ -166,15 +163,7 @@ void RunBook::checkpoint(const IntegratorState& st) {
   x.summary.insert(x.summary.end(), v.begin(), v.end());
   for (RunObserver* obs : rq_.observers)
     if (const std::string key = obs->state_key(); !key.empty()) x.add(key, obs->save());
-  std::vector<double> laws;  // what the laws remember (a digital PD's held and delayed values)
-  bool remember = false;
-  for (const std::shared_ptr<TorqueLaw>& law : laws_) {
-    const std::vector<double> m = law ? law->memory() : std::vector<double>{};
-    laws.push_back(static_cast<double>(m.size()));
-    laws.insert(laws.end(), m.begin(), m.end());
-    remember |= !m.empty();
-  }
-  if (remember) x.add(kLawsKey, std::move(laws));
+  if (std::vector<double> laws = pack_law_memory(inputs_); !laws.empty()) x.add(kLawsKey, std::move(laws));
   const std::vector<double> packed = x.pack();
   for (RunObserver* obs : rq_.observers) obs->checkpoint(packed);
 }

@@ -170,7 +170,7 @@ class RunBook {
   RunResult s_;
   std::unique_ptr<ValidityMonitor> validity_;
   std::unique_ptr<SensorBank> sensors_;  // null without [[sensors]]
-  std::vector<std::shared_ptr<TorqueLaw>> laws_;  // the force-input joints' (their memory checkpointed)
+  std::vector<JointInput> inputs_;  // (sharing the run's laws: their memory is checkpointed)
   std::vector<std::vector<double>> rows_;
   double balance0_ = NAN, wall_before_ = 0.0;
   std::chrono::steady_clock::time_point t0_;

@@ -61,11 +61,8 @@ const char* kAxisNames[6] = {"x1", "x2", "x3", "phi1", "phi2", "phi3"};
 std::vector<double> SimulationState::pack() const {
   std::vector<double> x = {kStateVersion, static_cast<double>(drives.size())};
   x.insert(x.end(), drives.begin(), drives.end());
-  x.push_back(static_cast<double>(memory.size()));
-  for (const std::vector<double>& m : memory) {
-    x.push_back(static_cast<double>(m.size()));
-    x.insert(x.end(), m.begin(), m.end());
-  }
+  x.push_back(static_cast<double>(laws.size()));
+  x.insert(x.end(), laws.begin(), laws.end());
   const std::vector<double> i = integrator.pack();
   x.insert(x.end(), i.begin(), i.end());
   return x;
@@ -85,12 +82,9 @@ SimulationState SimulationState::unpack(const std::string& model, const std::vec
   s.drives.assign(x.begin() + 2, x.begin() + 2 + static_cast<long>(nd));
   size_t i = 2 + nd;
   if (x[0] == kStateVersion) {
-    s.memory.resize(count(i++));
-    for (std::vector<double>& m : s.memory) {
-      const size_t k = count(i++);
-      m.assign(x.begin() + static_cast<long>(i), x.begin() + static_cast<long>(i + k));
-      i += k;
-    }
+    const size_t k = count(i++);
+    s.laws.assign(x.begin() + static_cast<long>(i), x.begin() + static_cast<long>(i + k));
+    i += k;
   }
   s.integrator = IntegratorState::unpack(std::vector<double>(x.begin() + static_cast<long>(i), x.end()), -1);
   return s;
@@ -189,13 +183,6 @@ struct Simulation::Impl {
       held[j]->tau_ff = x[4];
     }
   }
-  void apply_memory(const std::vector<std::vector<double>>& memory) {
-    if (memory.empty()) return;  // (a state of version 1: the laws start afresh)
-    if (memory.size() != inputs.size()) throw std::invalid_argument("the state's laws do not fit this model");
-    for (size_t j = 0; j < inputs.size(); ++j)
-      if (inputs[j].torque) inputs[j].torque->restore(memory[j]);
-      else if (!memory[j].empty()) throw std::invalid_argument("the state's laws do not fit this model");
-  }
   void bring_inputs_up_to_date() {
     if (!changed || status.kind != RunStatus::Kind::Running) return;
     stepper->inputs_changed();
@@ -261,7 +248,7 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
   m.eq = std::make_unique<EquationsOfMotion>(m.model, m.inputs, m.o.forces, m.rq.stop, m.o.linear_solver, m.o.parallel);
   if (from) {
     m.apply_drives(from->drives);
-    m.apply_memory(from->memory);
+    if (!from->laws.empty()) restore_law_memory(m.inputs, from->laws);  // (version 1: the laws start afresh)
   }  // (after the equations took the case laws' gains for Newton)
   if (m.eq->unknowns() == 0)
     throw CaseError(cs.path + ": joints: every joint follows a prescribed motion and there is no flexible link: nothing to step "
@@ -444,7 +431,7 @@ SimulationState Simulation::state() const {
       d[3] = h->v_ref;
       d[4] = h->tau_ff;
     }
-  for (const JointInput& in : m.inputs) s.memory.push_back(in.torque ? in.torque->memory() : std::vector<double>{});
+  s.laws = pack_law_memory(m.inputs);
   return s;
 }
 

@@ -26,8 +26,8 @@ struct SimulationState {
   IntegratorState integrator;
   /// Per joint, what it holds: kHeldNone, kHeldTorque (τ) or kHeldReference (q_ref, q̇_ref, τ_ff).
   std::vector<double> drives;
-  /// Per joint, what its law remembers (TorqueLaw::memory: a digital PD's held and delayed values).
-  std::vector<std::vector<double>> memory;
+  /// What the joints' laws remember (pack_law_memory: a digital PD's held and delayed values).
+  std::vector<double> laws;
   double time() const { return integrator.t; }
   /// As doubles (a version first), and back (std::invalid_argument for text that is not one).
   std::vector<double> pack() const;
