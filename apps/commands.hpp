@@ -72,7 +72,7 @@ int print_sweep(const Sweep& s, const std::vector<SweepRow>& rows, const StopTok
 /// `rfem plot RESULTS.h5 [-o DIR]`: PNG figures of a results or refinement file.
 int run_plot(const std::string& results, const std::string& outdir, const std::string& format = "", bool paper_signs = false);
 
-/// `rfem animate RESULTS.h5 …`: the arm moving, as MP4 or GIF (options passed to rfem_animate.py).
+/// `rfem animate RESULTS.h5 …`: the arm moving, as MP4 or GIF (options passed to python3 -m rfem.animate).
 int run_animate(const std::vector<std::string>& args);
 /// `rfem view RESULTS.h5 [--run R]`: XDMF files for ParaView beside the results file.
 int run_view(const std::string& results, const std::vector<std::string>& runs);

@@ -90,7 +90,7 @@ void apply_override(toml::table& root, const std::string& file, const std::strin
 SimulationSettings read_simulation(const Reader& r, const toml::table& t) {
   const std::string p = "simulation";
   r.check_keys(t, p, {"t_end", "output_dt", "rtol", "atol", "atol_velocity", "max_step", "procedure", "store_flexible_every",
-                      "max_order", "max_steps", "integrator", "method", "initial", "state"});
+                      "max_order", "max_steps", "integrator", "linear_solver", "method", "initial", "state"});
   SimulationSettings s;
   IntegratorOptions& o = s.options;
   o.t_end = r.positive(t, p, "t_end");
@@ -110,6 +110,9 @@ SimulationSettings read_simulation(const Reader& r, const toml::table& t) {
   const std::string kind = r.string(t, p, "integrator", integrator_name(o.kind));
   if (!parse_integrator(kind, o.kind))
     r.fail(t.get("integrator"), p + ".integrator", "must be \"esdirk\" or \"bdf\" (got \"" + kind + "\")");
+  const std::string solver = r.string(t, p, "linear_solver", linear_solver_name(o.linear_solver));
+  if (!parse_linear_solver(solver, o.linear_solver))
+    r.fail(t.get("linear_solver"), p + ".linear_solver", "must be \"chain\" or \"cholmod\" (got \"" + solver + "\")");
   o.max_order = static_cast<int>(r.integer(t, p, "max_order", o.max_order, 1, 5));
   if (t.get("max_order") && o.kind != IntegratorKind::Bdf)
     r.fail(t.get("max_order"), p + ".max_order", "applies to integrator = \"bdf\" only");

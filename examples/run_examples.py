@@ -3,7 +3,12 @@
 SUNDIALS' habit: a changed number is a changed result.
 
     /usr/bin/python3 examples/run_examples.py [--pythonpath build/python] [--cpp BUILD_DIR]
-                                              [--only ex1,ex3] [--update]
+                                              [--only ex1,ex3,notebook] [--update]
+
+The notebook (notebook.ipynb) runs in a Jupyter kernel (Debian's python3-nbclient, python3-ipykernel;
+kernel python3, working directory the repository, --pythonpath passed into its environment); what it
+prints is its cells' standard output, and a line "[image/png]" or "[text/html]" for each figure or
+animation it shows.
 
 Text must match exactly; numbers to a relative 1e-5 (or 1e-12 absolute). Why 1e-5: builds for
 different CPUs round differently (an AVX-512 build against a portable one: the shipped cases'
@@ -27,6 +32,7 @@ PYTHON = ["ex1_paper_figures", "ex2_refinement", "ex3_parameter_study", "ex4_mod
           "ex7_urdf_arm", "ex8_control_loop", "ex9_input_shaping", "ex10_strain_feedback",
           "ex11_urdf_strain_feedback"]
 CPP = ["ex6_library", "ex12_controller"]
+NOTEBOOKS = ["notebook"]
 
 
 def same(expected, got):
@@ -48,6 +54,40 @@ def same(expected, got):
     return True
 
 
+class NotebookRun:
+    """A notebook executed by nbclient, with what subprocess.run returns: returncode, stdout, stderr."""
+
+    def __init__(self, path, env, timeout=600):
+        self.returncode, self.stdout, self.stderr = 0, "", ""
+        # finding the kernel imports ipykernel and debugpy here, which warns about Python's frozen modules
+        os.environ.setdefault("PYDEVD_DISABLE_FILE_VALIDATION", "1")
+        try:
+            import nbformat
+            from nbclient import NotebookClient
+        except ImportError as e:
+            self.returncode, self.stderr = -1, f"{e} (apt-get install python3-nbclient python3-nbformat python3-ipykernel)"
+            return
+        nb = nbformat.read(path, as_version=4)
+        client = NotebookClient(nb, kernel_name="python3", timeout=timeout,
+                                resources={"metadata": {"path": os.path.dirname(HERE)}})
+        with tempfile.TemporaryFile("w+") as log:  # the kernel's own output (debugpy's warnings), shown on failure
+            try:
+                client.execute(env=env, stdout=log, stderr=log)
+            except Exception as e:  # a cell's error (CellExecutionError), a kernel that died or timed out
+                log.seek(0)
+                self.returncode, self.stderr = 1, f"{e}\n{log.read()}"
+        out, err = [], []
+        for cell in nb.cells:
+            for o in cell.get("outputs", []) if cell.cell_type == "code" else []:
+                if o.output_type == "stream":
+                    (out if o.name == "stdout" else err).append(o.text)
+                elif o.output_type in ("display_data", "execute_result"):
+                    shown = [m for m in ("image/png", "text/html") if m in o.data]
+                    out.append("[%s]\n" % ", ".join(shown or ["text/plain"]))
+        self.stdout = "".join(out)
+        self.stderr = "".join(err) + self.stderr
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--pythonpath", help="directory holding the rfem package (default: the installed one)")
@@ -63,13 +103,21 @@ def main():
         built = os.path.abspath(args.cpp if os.path.isdir(args.cpp) else os.path.dirname(args.cpp))
         for name in CPP:
             jobs.append((name, [os.path.join(built, name), os.path.join(HERE, "..", "cases")]))
+    jobs += [(name, os.path.join(HERE, name + ".ipynb")) for name in NOTEBOOKS]
     if args.only:
         wanted = args.only.split(",")
         jobs = [(n, c) for n, c in jobs if any(n == w or n.startswith(w + "_") for w in wanted)]
-    failed = 0
+    failed = skipped = 0
     for name, cmd in jobs:
-        with tempfile.TemporaryDirectory() as scratch:
-            p = subprocess.run(cmd, cwd=scratch, capture_output=True, text=True, env=env)
+        if name in NOTEBOOKS:
+            p = NotebookRun(cmd, env)
+            if p.returncode == -1 and not args.only:  # asked for all: without Jupyter, the notebook is skipped
+                print(f"skip {name}: {p.stderr}")
+                skipped += 1
+                continue
+        else:
+            with tempfile.TemporaryDirectory() as scratch:
+                p = subprocess.run(cmd, cwd=scratch, capture_output=True, text=True, env=env)
         answer = os.path.join(HERE, "answers", name + ".out")
         if p.returncode != 0:
             print(f"FAIL {name}: exit {p.returncode}\n{p.stderr}")
@@ -87,7 +135,7 @@ def main():
             failed += 1
             print(f"FAIL {name}: its output differs from {answer}:")
             sys.stdout.writelines(difflib.unified_diff(expected.splitlines(True), p.stdout.splitlines(True), answer, "now"))
-    print(f"{len(jobs) - failed} examples agree with their answers, {failed} do not")
+    print(f"{len(jobs) - failed - skipped} examples agree with their answers, {failed} do not")
     return 1 if failed else 0
 
 

@@ -51,9 +51,20 @@ inline int positive(py::handle v, const std::string& name, long hi = INT_MAX) {
 /// rfes in all links: None is the case's own discretisation (0), else 1..kMaxRfes (as --n).
 inline int rfes(py::handle v, const std::string& name = "n") { return v.is_none() ? 0 : positive(v, name, kMaxRfes); }
 
-/// A team size: 0 (OpenMP's default, all cores) or a positive integer.
+/// Set in a child forked from a process that imported rfem (os.register_at_fork): GNU OpenMP's
+/// thread pool does not survive fork, and a team of two there waits forever.
+inline bool& forked() {
+  static bool f = false;
+  return f;
+}
+
+/// A team size: 0 (OpenMP's default, all cores) or a positive integer; at most 1 in a forked child.
 inline int threads(py::handle v, const std::string& name = "threads") {
-  return static_cast<int>(integer(v, name, 0, INT_MAX, "0 (all cores) or a positive integer"));
+  const int t = static_cast<int>(integer(v, name, 0, INT_MAX, "0 (all cores) or a positive integer"));
+  if (t > 1 && forked())
+    value_error(name, "0 or 1 in a process forked from one that imported rfem (OpenMP's threads do not survive fork: "
+                      "use multiprocessing's 'spawn' or 'forkserver' start method for more)", v);
+  return t;
 }
 
 /// A real number: int or float (numpy's too), not a bool or a string; finite unless allowed.

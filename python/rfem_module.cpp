@@ -11,10 +11,13 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <omp.h>
+
 #include <csignal>
 #include <memory>
 
 #include "arguments.hpp"
+#include "pickling.hpp"
 #include "rfem/cases/case_file.hpp"
 #include "rfem/results/xdmf.hpp"
 #include "rfem/results/errors.hpp"
@@ -184,6 +187,10 @@ PYBIND11_MODULE(_rfem, m) {
   py::register_exception<CaseError>(m, "CaseError", PyExc_ValueError);
   py::register_exception<ResultsError>(m, "ResultsError", PyExc_OSError);
   m.attr("MAX_RFES") = kMaxRfes;  // the most rfes n may ask for (the case file's limit)
+  m.def("_after_fork", [] {  // (os.register_at_fork: one thread by default in the child, never a team)
+    args::forked() = true;
+    omp_set_num_threads(1);
+  });
 
   py::class_<RunStatus>(m, "RunStatus", "How a run ended, parsed from its status text (RunStatus.parse(run.status)).")
       .def_static("parse", [](py::handle text) { return RunStatus::parse(args::text(text, "text")); }, py::arg("text"),
@@ -201,7 +208,8 @@ PYBIND11_MODULE(_rfem, m) {
       .def_readonly("signal", &RunStatus::signal, "interrupted: the signal that asked for the stop (0: a caller's stop)")
       .def_readonly("reason", &RunStatus::reason, "failed: why")
       .def("__str__", &RunStatus::to_string)
-      .def("__repr__", [](const RunStatus& s) { return "<rfem.RunStatus " + s.to_string() + ">"; });
+      .def("__repr__", [](const RunStatus& s) { return "<rfem.RunStatus " + s.to_string() + ">"; })
+      .def(py::pickle([](const RunStatus& s) { return s.to_string(); }, [](const std::string& t) { return RunStatus::parse(t); }));
 
   py::class_<Case>(m, "Case", "A case: a TOML case file as read and checked (rfem.load, rfem.Case.from_text).")
       .def_static("load", [](py::handle path, py::handle overrides) {
@@ -236,7 +244,11 @@ PYBIND11_MODULE(_rfem, m) {
       .def_readonly("has_simulation", &Case::has_simulation)
       .def_property_readonly("t_end", [](const Case& c) { return c.sim.options.t_end; })
       .def_property_readonly("output_dt", [](const Case& c) { return c.sim.options.output_dt; })
-      .def("__repr__", [](const Case& c) { return "<rfem.Case " + (c.name.empty() ? c.path : c.name) + ">"; });
+      .def("__repr__", [](const Case& c) {
+        return "<rfem.Case " + (c.name.empty() ? c.path : c.name) +
+               (c.overrides.empty() ? "" : " with " + std::to_string(c.overrides.size()) + " overrides") + ">";
+      })
+      .def(py::pickle(&pyorigin::case_state, &pyorigin::case_from));
 
   py::class_<Model, std::shared_ptr<Model>>(m, "Model", "A case's model: its links cut into rfes, its joints.")
       .def_property_readonly("n", &Model::n, "rfes of all links")
@@ -257,8 +269,15 @@ PYBIND11_MODULE(_rfem, m) {
       })
       .def("__repr__", [](const Model& md) {
         return "<rfem.Model n=" + std::to_string(md.n()) + " rfes, m=" + std::to_string(md.m()) + " joints>";
-      });
-  m.def("model", [](py::handle c, py::handle n) { return std::const_pointer_cast<Model>(model_of(*args::CaseArg(c), args::rfes(n))); },
+      })
+      .def(py::pickle(&pyorigin::model_state, &pyorigin::model_from));
+  m.def("model", [](py::handle c, py::handle n_arg) {
+    const args::CaseArg cs(c);
+    const int n = args::rfes(n_arg);
+    const auto md = model_of(*cs, n);
+    pyorigin::remember(md, *cs, n);
+    return std::const_pointer_cast<Model>(md);
+  },
         py::arg("case"), py::arg("n") = py::none(), "The case's model with n rfes in all (None: the case's own discretisation).");
 
   py::class_<RunResult, std::shared_ptr<RunResult>>(m, "Run", "One run of a study: status, statistics, peaks and series.")
@@ -289,10 +308,23 @@ PYBIND11_MODULE(_rfem, m) {
       }, py::arg("name"), "Series `name` (rows = outputs) as a read-only array, e.g. 'joint_tau', 'links/upper/tip_deflection'.")
       .def("column", [](const std::shared_ptr<RunResult>& r, py::handle series, py::handle column) {
         const std::string name = args::text(series, "name");
-        const long col = args::integer(column, "column", 0, INT_MAX, "a column number, 0 or more");
         if (!r->series) throw py::value_error("the run kept no series (keep_series=False)");
         const RunSeries::View v = r->series->view(name);
-        if (col < 0 || col >= v.info->width()) throw py::index_error("no column " + std::to_string(col) + " in " + name);
+        long col = -1;
+        if (PyUnicode_Check(column.ptr())) {  // by the column's name in the file ("u1")
+          const std::string c = args::text(column, "column");
+          const auto& cs = v.info->columns;
+          const auto it = std::find(cs.begin(), cs.end(), c);
+          if (it == cs.end()) {
+            std::string known;
+            for (const auto& x : cs) known += (known.empty() ? "" : ", ") + x;
+            throw py::key_error("no column '" + c + "' in " + name + " (columns: " + known + ")");
+          }
+          col = it - cs.begin();
+        } else {
+          col = args::integer(column, "column", 0, INT_MAX, "a column's name or number, 0 or more");
+          if (col >= v.info->width()) throw py::index_error("no column " + std::to_string(col) + " in " + name);
+        }
         const long w = v.info->width();
         auto* keep = new std::shared_ptr<const RunSeries>(r->series);
         py::capsule base(keep, [](void* p) { delete static_cast<std::shared_ptr<const RunSeries>*>(p); });
@@ -301,7 +333,8 @@ PYBIND11_MODULE(_rfem, m) {
                     std::vector<py::ssize_t>{static_cast<py::ssize_t>(sizeof(double) * w)}, v.data ? v.data + col : &empty, base);
         a.attr("flags").attr("writeable") = false;
         return a;
-      }, py::arg("name"), py::arg("column"), "One column of a series as a read-only 1-D array.")
+      }, py::arg("name"), py::arg("column"),
+         "One column of a series as a read-only 1-D array (a row per output): by its name in the file ('u1') or its number.")
       .def("info", [](const RunResult& r, py::handle series) {
         const std::string name = args::text(series, "name");
         if (!r.series) throw py::value_error("the run kept no series (keep_series=False)");
@@ -318,7 +351,8 @@ PYBIND11_MODULE(_rfem, m) {
       .def_readonly("sensor_units", &RunResult::sensor_units)
       .def("__repr__", [](const RunResult& r) {
         return "<rfem.Run " + r.name + ": " + r.status.to_string() + ", " + std::to_string(r.samples) + " outputs>";
-      });
+      })
+      .def(py::pickle(&pyorigin::run_state, &pyorigin::run_from));
 
   m.def("_run", [](py::handle case_arg, py::handle n_arg, py::handle output_arg, py::handle runs, py::handle threads,
                    py::handle keep_series, py::handle progress, py::handle checkpoint) {
@@ -338,6 +372,7 @@ PYBIND11_MODULE(_rfem, m) {
       // Into a file: the one path the program takes (studies/run_file.hpp); else in memory only.
       results = output.empty() ? run_case(cs, rq) : run_into_file(cs, rq, output, made_by).runs;
     }
+    pyorigin::remember_runs(results, cs, n);
     py::list out;
     for (auto& r : results) out.append(std::make_shared<RunResult>(std::move(r)));
     py::object error = pending->error;
@@ -355,13 +390,15 @@ PYBIND11_MODULE(_rfem, m) {
     RunRequest rq = python_request(pending, progress, threads, keep_series, checkpoint, warnings);
     std::vector<RunResult> results;
     std::vector<std::string> done;
+    std::optional<ResumePlan> plan_kept;
     {
       py::gil_scoped_release release;
-      const ResumePlan plan = plan_resume(path);
+      const ResumePlan& plan = plan_kept.emplace(plan_resume(path));
       done = plan.done;
       results = resume_case(plan, rq);
       if (!results.empty()) write_views(plan.cs, *results.back().model, path, rq.warn);
     }
+    pyorigin::remember_runs(results, plan_kept->cs, plan_kept->n);
     py::list out;
     for (auto& r : results) out.append(std::make_shared<RunResult>(std::move(r)));
     py::object error = pending->error;
@@ -408,13 +445,22 @@ PYBIND11_MODULE(_rfem, m) {
                                         py::arg("rotation") = vector_array(t.motion.tail<3>()));
         return d;
       }, "per link: its free end's displacement [m] and rotation [rad] in its {r}")
-      .def_property_readonly("model", [](const StaticStudy& s) { return std::const_pointer_cast<Model>(s.model); });
+      .def_property_readonly("model", [](const StaticStudy& s) { return std::const_pointer_cast<Model>(s.model); })
+      .def("__repr__", [](const StaticStudy& s) {
+        return "<rfem.StaticResult n=" + std::to_string(s.model->n()) + " rfes, " + std::to_string(s.solution.iterations) +
+               " iterations, residual " + py::repr(py::float_(s.solution.residual)).cast<std::string>() + " N>";
+      });
   m.def("_static", [](py::handle case_arg, py::handle n_arg, py::handle rate, py::handle joint) {
     const args::CaseArg cs(case_arg);
     const int n = args::rfes(n_arg);
     const JointRate r = joint_rate(rate, joint);
-    py::gil_scoped_release release;
-    return std::make_shared<StaticStudy>(static_study(*cs, n, r));
+    std::shared_ptr<StaticStudy> s;
+    {
+      py::gil_scoped_release release;
+      s = std::make_shared<StaticStudy>(static_study(*cs, n, r));
+    }
+    pyorigin::remember(s->model, *cs, n);
+    return s;
   }, py::arg("case"), py::arg("n"), py::arg("rate"), py::arg("joint"));
 
   py::class_<ModesStudy, std::shared_ptr<ModesStudy>>(m, "ModesResult", "Natural frequencies and mode shapes (rfem.modes).")
@@ -428,8 +474,8 @@ PYBIND11_MODULE(_rfem, m) {
         return k;
       }, "axial, bending-y, bending-z, torsion or rigid")
       .def_readonly("index_of_kind", &ModesStudy::index_of_kind)
-      .def_property_readonly("shapes", [](const ModesStudy& s) { return py::array(py::cast(s.modes.shapes)); },
-                             "one column per mode: the rfe coordinates, then the free joints' (M-normalised)")
+      .def_property_readonly("shapes", [](const ModesStudy& s) { return py::array(py::cast(Eigen::MatrixXd(s.modes.shapes.transpose()))); },
+                             "a row per mode (as modes/shapes in the file): the rfe coordinates, then the free joints' (M-normalised)")
       .def_property_readonly("equilibrium", [](const ModesStudy& s) { return vector_array(s.modes.q0); })
       .def_property_readonly("uncertainty", [](const ModesStudy& s) { return vector_array(s.modes.uncertainty); })
       .def_readonly("free_joints", &ModesStudy::free_names)
@@ -443,7 +489,15 @@ PYBIND11_MODULE(_rfem, m) {
         return out;
       }, "per mode, for one uniform segment: the exact value it converges to")
       .def_readonly("warnings", &ModesStudy::warnings)
-      .def_property_readonly("model", [](const ModesStudy& s) { return std::const_pointer_cast<Model>(s.model); });
+      .def_property_readonly("model", [](const ModesStudy& s) { return std::const_pointer_cast<Model>(s.model); })
+      .def("__repr__", [](const ModesStudy& s) {
+        std::string f;
+        for (int i = 0; i < std::min<int>(3, static_cast<int>(s.modes.omega.size())); ++i)
+          f += (f.empty() ? "" : ", ") + py::repr(py::float_(s.frequency_hz(i))).cast<std::string>();
+        if (s.modes.omega.size() > 3) f += ", …";
+        return "<rfem.ModesResult " + std::to_string(s.modes.omega.size()) + " modes, n=" + std::to_string(s.model->n()) +
+               " rfes: " + f + " Hz>";
+      });
   m.def("_modes", [](py::handle case_arg, py::handle n, py::handle count, py::handle free, py::handle rate, py::handle joint,
                      py::handle output_arg) {
     const args::CaseArg cs_arg(case_arg);
@@ -461,6 +515,7 @@ PYBIND11_MODULE(_rfem, m) {
       write_modes(file, *s);
       file.close();
     }
+    pyorigin::remember(s->model, cs, rq.n);  // (C++ only: no GIL needed)
     return s;
   }, py::arg("case"), py::arg("n"), py::arg("count"), py::arg("free"), py::arg("rate"), py::arg("joint"), py::arg("output"));
 

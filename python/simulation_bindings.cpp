@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "arguments.hpp"
+#include "pickling.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/simulation.hpp"
 
@@ -143,8 +144,10 @@ void bind_simulation(py::module_& m) {
              const args::CaseArg cs(case_arg);
              auto p = std::make_unique<PySimulation>();
              SimulationOptions o = options(n, threads, output, keep_series, std::move(state), made_by, p->poll);
+             const int n_rfes = o.n;
              py::gil_scoped_release release;
              p->sim = std::make_unique<Simulation>(*cs, std::move(o));
+             pyorigin::remember(p->sim->shared_model(), *cs, n_rfes);
              return p;
            }),
            py::arg("case"), py::arg("n"), py::arg("threads"), py::arg("output"), py::arg("keep_series"), py::arg("state"),
@@ -253,7 +256,9 @@ void bind_simulation(py::module_& m) {
     {
       py::gil_scoped_release release;
       model = model_of(cs, o.n);  // (the snapshot's names; the same as the run's model)
+      const int n_rfes = o.n;
       result = std::make_shared<RunResult>(run_controlled(cs, std::move(o), f, c));
+      pyorigin::remember(result->model, cs, n_rfes);
     }
     // A non-finite value the C++ loop refused is a ValueError too.
     if (poll->bad.is_none() && result->status.kind == RunStatus::Kind::Failed &&

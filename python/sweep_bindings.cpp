@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "arguments.hpp"
+#include "pickling.hpp"
 #include "rfem/solvers/run_status.hpp"
 #include "rfem/studies/sweep.hpp"
 
@@ -88,7 +89,12 @@ void bind_sweep(py::module_& m) {
                               py::arg("cost") = p.cost));
         return out;
       })
-      .def("__len__", [](const Sweep& s) { return s.points.size(); });
+      .def("__len__", [](const Sweep& s) { return s.points.size(); })
+      .def("__repr__", [](const Sweep& s) {
+        return "<rfem.Sweep " + s.path + ": " + std::to_string(s.points.size()) + " points over " +
+               std::to_string(s.parameters.size()) + " parameters, index " + s.index + ">";
+      })
+      .def(py::pickle(&pyorigin::sweep_state, &pyorigin::sweep_from));
 
   m.def("load_sweep", [](py::handle path, py::handle output) {
     return read_sweep(args::path(path, "path"), args::path(output, "output", true));

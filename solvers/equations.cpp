@@ -146,7 +146,7 @@ VecX EquationsOfMotion::accelerations(double t, const double* qu, const double* 
   VecX rhs(u);
   residual(t, qu, vu, nullptr, rhs.data());
   rhs = -rhs;
-  if (!solve_mass(*model_, newton_->pattern(), base_col_, q_, v_, rhs, mass_values_))
+  if (!solve_mass(*model_, newton_->pattern(), base_col_, q_, v_, rhs, mass_values_, &ws_))
     throw std::runtime_error("the mass matrix is not positive definite at t = " + std::to_string(t) + " s");
   std::vector<double>().swap(mass_values_);  // needed once or at output times: do not keep it
   return rhs;
@@ -219,7 +219,9 @@ void EquationsOfMotion::initial_state(VecX& qu, VecX& vu, bool static_equilibriu
     qb[j] = law ? inputs_[j].motion->at(0.0).q : inputs_[j].q0;
     vb[j] = law ? inputs_[j].motion->at(0.0).qd : inputs_[j].v0;
   }
-  const StaticResult eq = solve_static(*model_, qb, vb, TipLoads{});
+  StaticOptions so;
+  so.parallel = ws_.parallel;  // (the run's threads, also here)
+  const StaticResult eq = solve_static(*model_, qb, vb, TipLoads{}, so);
   qu.head(model_->flexible_dofs()) = eq.q.head(model_->flexible_dofs());
 }
 

@@ -4,14 +4,14 @@
 namespace rfem {
 
 bool solve_mass(const Model& model, const BorderedPattern& pattern, const std::vector<int>& base_col,
-                const VecX& q, const VecX& v, VecX& b, std::vector<double>& values) {
+                const VecX& q, const VecX& v, VecX& b, std::vector<double>& values, Workspace* ws) {
   RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
   RFEM_CHECK_ARGUMENT_SIZE(v.size(), model.dof(), "v");
   RFEM_CHECK_ARGUMENT_SIZE(base_col.size(), model.m(), "base_col");
   RFEM_CHECK_ARGUMENT_SIZE(b.size(), pattern.size(), "b");
   MatrixTerms mt;
   mt.mass = 1.0;
-  assemble_matrices(model, pattern, base_col, q, v, mt, values, {});
+  assemble_matrices(model, pattern, base_col, q, v, mt, values, {}, nullptr, ws);
   const int n = pattern.n_blocks(), nb = pattern.n_base(), n6 = 6 * n;
   auto entry = [&](int r, int c) { return values[pattern.slot(std::min(r, c), std::max(r, c))]; };
   MatX S(nb, nb);  // Schur complement on the border

@@ -8,8 +8,9 @@
 
 namespace rfem {
 
-/// Returns false if a block is not positive definite. `values` is scratch (pattern.nnz()).
+/// Returns false if a block is not positive definite. `values` is scratch (pattern.nnz()); `ws`:
+/// the caller's workspace (its thread count), or null for a local one.
 bool solve_mass(const Model& model, const BorderedPattern& pattern, const std::vector<int>& base_col,
-                const VecX& q, const VecX& v, VecX& b, std::vector<double>& values);
+                const VecX& q, const VecX& v, VecX& b, std::vector<double>& values, Workspace* ws = nullptr);
 
 }  // namespace rfem

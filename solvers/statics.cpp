@@ -107,7 +107,7 @@ StaticResult solve_static(const Model& model, const VecX& qb, const VecX& vb, co
   terms.gravity = true;
   terms.inertial = vb.size() > 0 && vb.norm() > 0.0;
   std::vector<double> values;
-  Workspace ws(model);  // the Newton iteration's scratch, cut once
+  Workspace ws(model, opts.parallel);  // the Newton iteration's scratch, cut once
 
   // Load scale for the convergence test: the full load vector at the undeformed state.
   const double scale = std::max(residual(model, res.q, v, loads, 1.0, ws).norm(), 1e-12);

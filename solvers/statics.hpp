@@ -5,6 +5,7 @@
 // centrifugal), with load stepping when a full step does not converge.
 #include "rfem/core/model.hpp"
 #include "rfem/core/positions.hpp"
+#include "rfem/assembly/workspace.hpp"
 
 namespace rfem {
 
@@ -21,6 +22,7 @@ struct StaticOptions {
   double tolerance = 1e-10;       ///< on the residual, relative to the applied load scale
   double step_tolerance = 1e-13;  ///< on the Newton correction, relative to the coordinates
   int max_load_steps = 64;
+  Parallelism parallel;  ///< the residual's team (a run's: its `threads`)
 };
 
 struct StaticResult {

@@ -38,3 +38,13 @@ grep -q "rfem plot: error: bad.h5" err.txt || { echo "FAIL: message"; cat err.tx
 "$rfem" plot paper.h5 -o pdf --format pdf --paper-signs >/dev/null
 head -c 4 pdf/fig5_tip.pdf | grep -q "%PDF" || { echo "FAIL: no PDF"; exit 1; }
 echo "ok pdf"
+# rfem plot runs the package's module (python3 -m rfem.plots) found beside the program: not an rfem/
+# in the current directory, and RFEM_PYTHONPATH, when set, must hold the package.
+mkdir -p decoy/rfem && echo 'raise SystemExit("the rfem/ of the current directory was imported")' > decoy/rfem/__init__.py
+(cd decoy && "$rfem" plot ../paper.h5 -o ../decoyfigs >/dev/null 2>err.txt) || { echo "FAIL: decoy package"; cat decoy/err.txt; exit 1; }
+[ -s decoyfigs/fig5_tip.png ] || { echo "FAIL: no figures beside a decoy rfem/"; exit 1; }
+echo "ok rfem/ of the current directory not imported"
+if RFEM_PYTHONPATH=/nonexistent "$rfem" plot paper.h5 -o none 2>err.txt; then echo "FAIL: a wrong RFEM_PYTHONPATH accepted"; exit 1; fi
+[ "$(wc -l < err.txt)" = 1 ] && grep -q "RFEM_PYTHONPATH=/nonexistent: no rfem/plots.py there" err.txt \
+  || { echo "FAIL: RFEM_PYTHONPATH message"; cat err.txt; exit 1; }
+echo "ok RFEM_PYTHONPATH checked"

@@ -11,6 +11,8 @@ The same operations as the `rfem` program, from Python, with the same checks and
 
     rfem.static(case), rfem.modes(case, count=6), rfem.refine(case, ns=[6, 12, 24], quantities=["peak:u1"])
     rfem.plot("results.h5")                                    # the figures of `rfem plot`
+    rfem.plots.tips(runs["force"])                             # a Figure (Jupyter: inline); ax=, fig=: yours
+    rfem.animate("arm.h5", output="arm.gif")                   # `rfem animate`; rfem.animate.frame(…, ax=…)
 
 Errors in a case are `rfem.CaseError` (a ValueError) with the program's one-line message
 ("FILE:LINE: key: what is wrong"); a results file that cannot be written is `rfem.ResultsError`
@@ -23,14 +25,38 @@ Units are SI; the results layout is README.md's "Results (HDF5)".
 import math as _math
 import json as _json
 import os as _os
-import subprocess as _subprocess
-import sys as _sys
 
 from . import _rfem
 from ._rfem import (MAX_RFES, Case, CaseError, Model, ModesResult, ResultsError, Run, RunStatus, StaticResult, Sweep,
-                    __version__, build, finished_point, run_point, write_index, write_xdmf)
+                    __version__, build)
 
-__all__ = ["Case", "CaseError", "Model", "ModesResult", "ResultsError", "Run", "RunInterrupted", "RunStatus", "Runs",
+
+# The compiled functions wrapped in Python ones: a pool pickles a function by its module and name,
+# which pybind11's own functions do not have.
+def run_point(sweep, k, threads=1):
+    return _rfem.run_point(sweep, k, threads)
+
+
+def finished_point(sweep, k):
+    return _rfem.finished_point(sweep, k)
+
+
+def write_index(sweep, rows):
+    return _rfem.write_index(sweep, rows)
+
+
+def write_xdmf(results, runs=()):
+    return _rfem.write_xdmf(results, runs)
+
+
+# A forked child (multiprocessing's default start on Linux) runs one thread: GNU OpenMP's thread pool
+# does not survive fork, and a team there would wait forever (threads > 1 is refused there).
+_os.register_at_fork(after_in_child=_rfem._after_fork)
+
+for _f in (run_point, finished_point, write_index, write_xdmf):
+    _f.__doc__ = getattr(_rfem, _f.__name__).__doc__.split("\n", 1)[-1].strip()
+
+__all__ = ["Case", "CaseError", "Frame", "Model", "ModesResult", "ResultsError", "Run", "RunInterrupted", "RunStatus", "Runs",
            "StaticResult", "RefineResult", "Tree", "load", "model", "show", "run", "static", "modes", "refine", "plot",
            "write_xdmf", "animate", "toml_value", "__version__", "Sweep", "SweepResult", "load_sweep", "sweep", "run_point",
            "finished_point", "write_index"]
@@ -80,6 +106,32 @@ def _with_values(self, values):
 Case.with_values = _with_values
 
 
+class Frame(dict):
+    """One series of a run by column name ({"u1": array, …}, a row per output) with .units
+    {column: unit}, .name and .description, as in the results file (Run.frame)."""
+
+    name = ""
+    description = ""
+    units = {}
+
+    def __repr__(self):
+        cols = ", ".join(f"{c} [{u}]" if u else c for c, u in self.units.items())
+        rows = len(next(iter(self.values()))) if self else 0
+        return f"<rfem.Frame {self.name}: {rows} rows; {cols}>"
+
+
+def _frame(self, name):
+    """Series `name` by column name: a Frame {column: read-only 1-D array} with .units."""
+    info = self.info(name)
+    table = self.table(name)
+    f = Frame((c, table[:, k]) for k, c in enumerate(info["columns"]))
+    f.name, f.description, f.units = info["name"], info["description"], dict(zip(info["columns"], info["units"]))
+    return f
+
+
+Run.frame = _frame
+
+
 def load(path, values=None, overrides=()):
     """Reads and checks a case file (TOML). `values`: {path: value} as in Case.with_values;
     `overrides`: 'key.path=value' strings as given to `rfem --set`."""
@@ -109,6 +161,9 @@ class Runs(list):
 
     warnings = ()
     kept = ()
+
+    def __repr__(self):
+        return "<rfem.Runs " + ", ".join(f"{r.name}: {r.status}" for r in self) + ">"
 
 
 def _raise(error, result):
@@ -184,6 +239,10 @@ class Tree(list):
     def __str__(self):
         return self.text
 
+    def __repr__(self):
+        return f"<rfem.Tree {len(self)} entries: " + ", ".join(f"{e['kind']} {e['name']}" for e in self[:6]) + \
+            (", …" if len(self) > 6 else "") + ">"
+
 
 def show(case, n=None):
     """What the case builds, to check against its drawing: every joint, link and payload with
@@ -221,6 +280,10 @@ class RefineResult(dict):
                 return t
         raise KeyError(quantity)
 
+    def __repr__(self):
+        return f"<rfem.RefineResult {self['status']}: n = {list(self['ns'])}, " + \
+            ", ".join(f"{t['quantity']} order {t['fitted_order']:.3g}" for t in self["tables"]) + ">"
+
 
 def refine(case, ns, quantities, output=None, integration_check=True, rate=None, joint=1, threads=0, progress=None):
     """Quantities over an increasing series of n with observed orders and Richardson values
@@ -252,6 +315,11 @@ class SweepResult(dict):
 
     warnings = ()
 
+    def __repr__(self):
+        done = sum(RunStatus.parse(s).completed for s in self["status"])
+        return f"<rfem.SweepResult {len(self['status'])} points ({done} completed) over {self['parameters']}: " \
+            f"{self['quantities']}; index {self['index']}>"
+
 
 def load_sweep(path, output=None):
     """Reads a sweep file and checks every point before anything runs; returns a Sweep (its
@@ -277,52 +345,27 @@ def sweep(path, output=None, jobs=0, retry_failed=False, progress=None):
     return result
 
 
-def _plot_script():
-    env = _os.environ.get("RFEM_PLOT_SCRIPT")
-    if env:
-        return env
-    here = _os.path.dirname(_os.path.abspath(__file__))
-    for candidate in (_os.path.join(here, "rfem_plot.py"),):
-        if _os.path.exists(candidate):
-            return candidate
-    raise FileNotFoundError("rfem_plot.py not found beside the rfem package (set RFEM_PLOT_SCRIPT)")
-
-
-def animate(results, output=None, run=None, scale=None, view="3d", fps=25, frames=300):
-    """The arm of a run moving (`rfem animate`): MP4 (ffmpeg) or GIF by the output's extension
-    (default RESULT.RUN.mp4, .gif without ffmpeg); scale magnifies the deflections (default: the
-    peak drawn at 10 % of the arm); view 3d, xy, xz or yz. Needs a run that stored its poses
-    (simulation.store_flexible_every > 0). Returns the path written; errors raise RuntimeError with
-    the program's one-line message."""
-    args = [_os.fspath(results), "--view", view, "--fps", str(fps), "--frames", str(frames)]
-    args += (["-o", _os.fspath(output)] if output else []) + (["--run", run] if run else []) + \
-        (["--scale", repr(float(scale))] if scale is not None else [])
-    out = _script("rfem_animate.py", "RFEM_ANIMATE_SCRIPT", args, "rfem animate: error: ")
-    return [l[len("wrote "):].split(" (")[0] for l in out.splitlines() if l.startswith("wrote ")][0]
-
-
-def _script(name, env, args, prefix):
-    path = _os.environ.get(env) or _os.path.join(_os.path.dirname(_os.path.abspath(__file__)), name)
-    if not _os.path.exists(path):
-        raise FileNotFoundError("%s not found beside the rfem package (set %s)" % (name, env))
-    p = _subprocess.run([_sys.executable, path] + args, capture_output=True, text=True)
-    if p.returncode != 0:
-        lines = [l for l in p.stderr.strip().splitlines() if l.startswith(prefix)] or p.stderr.strip().splitlines()
-        raise RuntimeError(lines[-1].replace(prefix, "") if lines else name + " failed")
-    return p.stdout
-
-
 def plot(results, outdir=None, format="png", paper_signs=False):
     """The figures of `rfem plot` for a results or refinement file (default directory: the
     file's; format png, pdf or svg; paper_signs: u1, u2 with the paper's sign); returns the paths
-    written. A file it cannot read raises RuntimeError with the program's one-line message."""
-    cmd = [_sys.executable, _plot_script(), _os.fspath(results), "--format", format] + \
-        (["-o", _os.fspath(outdir)] if outdir else []) + (["--paper-signs"] if paper_signs else [])
-    p = _subprocess.run(cmd, capture_output=True, text=True)
-    if p.returncode != 0:
-        lines = [l for l in p.stderr.strip().splitlines() if l.startswith("rfem plot: error: ")] or p.stderr.strip().splitlines()
-        raise RuntimeError(lines[-1].replace("rfem plot: error: ", "") if lines else "rfem plot failed")
-    return [l[len("wrote "):] for l in p.stdout.splitlines() if l.startswith("wrote ")]
+    written. A file it cannot read raises rfem.plots.PlotError (a RuntimeError) with the program's
+    one-line message. To draw onto your own matplotlib Axes (Jupyter: inline): rfem.plots."""
+    from . import plots
+    return plots.write(results, outdir, format, paper_signs)
+
+
+def __getattr__(name):
+    # rfem.plots and rfem.animate: modules imported when first used (matplotlib and h5py load then).
+    # rfem.animate is callable: rfem.animate(results, output=None, run=None, scale=None, view="3d",
+    # fps=25, frames=300) writes the film and returns its path (python/rfem/animate.py).
+    if name in ("plots", "animate"):
+        import importlib
+        return importlib.import_module("." + name, __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | {"plots", "animate"})
 
 
 # A simulation a script steps and controllers in the loop (python/rfem/simulation.py).
