@@ -69,6 +69,13 @@ int run_sweep_mpi(const SweepOptions& o, bool json, bool quiet);
 /// The sweep's progress line (stderr, on a terminal) and its table or JSON; the exit code.
 void print_sweep_progress(const SweepProgress& p);
 int print_sweep(const Sweep& s, const std::vector<SweepRow>& rows, const StopToken& stop, bool json, bool quiet);
+struct LinearizeOptions {
+  std::string output;     ///< -o LIN.h5
+  std::string state;      ///< --state SAVED.h5: about a saved simulation state (default: the initial equilibrium)
+  bool on_motion = false; ///< --on-motion: the state's own accelerations (default: at rest)
+};
+/// `rfem linearize CASE -o LIN.h5`: the linear model into HDF5 (studies/linearize.hpp).
+int run_linearize(const Common& c, const LinearizeOptions& o);
 /// `rfem plot RESULTS.h5 [-o DIR]`: PNG figures of a results or refinement file.
 int run_plot(const std::string& results, const std::string& outdir, const std::string& format = "", bool paper_signs = false);
 

@@ -150,6 +150,12 @@ int main(int argc, char** argv) {
   rf->add_flag("--no-integration-check", no_check,
                "do not rerun the finest n at 100x tighter tolerances to estimate the integration error");
   add_rate(rf);
+  auto* ln = app.add_subcommand("linearize", "the linear model M, D, K, B, C and A, B, C, D about the initial equilibrium or a saved state");
+  add_common(ln, true);
+  LinearizeOptions lo;
+  ln->add_option("-o,--output", lo.output, "HDF5 file for the matrices (group linear)")->required();
+  ln->add_option("--state", lo.state, "about this saved simulation state (rfem.SimulationState.save; default: the initial equilibrium)");
+  ln->add_flag("--on-motion", lo.on_motion, "with the state's own accelerations (default: at rest, the inputs that hold it in u0)");
   auto* sw = app.add_subcommand("sweep", "a parameter sweep: one run per point, quantities per run, one index (--jobs, or under mpirun)");
   SweepOptions so;
   bool sweep_json = false, sweep_quiet = false;
@@ -166,7 +172,7 @@ int main(int argc, char** argv) {
     bool known = false;
     for (const auto* sub : app.get_subcommands([](const CLI::App*) { return true; })) known |= sub->get_name() == w;
     if (!known) {
-      print_line(fmt::format("rfem: error: unknown command '{}' (show, static, modes, run, refine, sweep, plot, view, animate; rfem --help)", w));
+      print_line(fmt::format("rfem: error: unknown command '{}' (show, static, modes, linearize, run, refine, sweep, plot, view, animate; rfem --help)", w));
       return 2;
     }
   }
@@ -194,6 +200,7 @@ int main(int argc, char** argv) {
     if (sh->parsed()) return run_show(common);
     if (st->parsed()) return run_static(common, mo);
     if (md->parsed()) return run_modes(common, mo);
+    if (ln->parsed()) return run_linearize(common, lo);
     if (pl->parsed()) return run_plot(plot_file, plot_dir, plot_format, paper_signs);
     if (vw->parsed()) return run_view(view_file, view_runs);
     if (an->parsed()) {

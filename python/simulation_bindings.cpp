@@ -11,7 +11,11 @@
 
 #include "arguments.hpp"
 #include "pickling.hpp"
+#include <pybind11/eigen.h>
+
+#include "rfem/results/writer.hpp"
 #include "rfem/studies/inputs.hpp"
+#include "rfem/studies/recorders.hpp"
 #include "rfem/studies/simulation.hpp"
 
 namespace py = pybind11;
@@ -182,6 +186,11 @@ void bind_simulation(py::module_& m) {
       })
       .def("snapshot", [](PySimulation& p) { return snapshot_dict(p.sim->snapshot(), p.sim->model()); })
       .def("state", [](const PySimulation& p) { return p.sim->state(); })
+      .def("linearize", [](PySimulation& p, py::handle equilibrium) {
+        const bool eq = args::flag(equilibrium, "equilibrium");
+        py::gil_scoped_release release;
+        return std::make_shared<LinearModel>(p.sim->linearize(eq));
+      })
       .def("finish", [](PySimulation& p) {
         std::shared_ptr<RunResult> r;
         {
@@ -190,6 +199,67 @@ void bind_simulation(py::module_& m) {
         }
         return r;
       });
+
+  py::class_<LinearModel, std::shared_ptr<LinearModel>>(
+      m, "LinearModel",
+      "A linear model about a state (rfem.linearize, Simulation.linearize): M q'' + D q' + K q = B u, "
+      "y = Cq q + Cv q' + Ca q'' (deviations from the operating point; SI units, rows and columns named by "
+      "states, inputs, outputs); state_space() gives A, B, C, D of x = (q, q').")
+      .def_readonly("t", &LinearModel::t, "the state's time [s]")
+      .def_readonly("equilibrium", &LinearModel::equilibrium, "about rest (q'' = 0) or the motion")
+      .def_readonly("states", &LinearModel::states, "the unknowns: rfe coordinates LINK/rfeK/x1 … phi3, free joints")
+      .def_readonly("inputs", &LinearModel::inputs, "free joints: a torque [N m] (force [N]) added to each")
+      .def_readonly("outputs", &LinearModel::outputs, "LINK/tip_u1 … tip_theta, JOINT/q, v, tau, sensor columns")
+      .def_readonly("output_units", &LinearModel::output_units)
+      .def_property_readonly("M", [](const LinearModel& l) { return l.M; }, "states × states [kg, kg m, kg m²]")
+      .def_property_readonly("D", [](const LinearModel& l) { return l.D; }, "states × states: damping, PD kd, gyroscopic")
+      .def_property_readonly("K", [](const LinearModel& l) { return l.K; }, "states × states: elastic, geometric, gravity, centrifugal, PD kp")
+      .def_property_readonly("B", [](const LinearModel& l) { return l.B; }, "states × inputs")
+      .def_property_readonly("Cq", [](const LinearModel& l) { return l.Cq; }, "outputs × states")
+      .def_property_readonly("Cv", [](const LinearModel& l) { return l.Cv; }, "outputs × states")
+      .def_property_readonly("Ca", [](const LinearModel& l) { return l.Ca; }, "outputs × states")
+      .def_property_readonly("q0", [](const LinearModel& l) { return array(l.q0); }, "the operating point (states)")
+      .def_property_readonly("v0", [](const LinearModel& l) { return array(l.v0); })
+      .def_property_readonly("a0", [](const LinearModel& l) { return array(l.a0); })
+      .def_property_readonly("u0", [](const LinearModel& l) { return array(l.u0); }, "the inputs that hold the state")
+      .def_property_readonly("y0", [](const LinearModel& l) { return array(l.y0); }, "the outputs there")
+      .def_readonly("imbalance", &LinearModel::imbalance, "the rfe rows' residual there, relative (≪ 1 at an equilibrium)")
+      .def("state_space", [](const LinearModel& l) {
+        MatX A, B, C, D;
+        {
+          py::gil_scoped_release release;
+          l.state_space(A, B, C, D);
+        }
+        return py::make_tuple(A, B, C, D);
+      }, "(A, B, C, D) of x' = A x + B u, y = C x + D u with x = (q, q'): 2N states")
+      .def_property_readonly("first_order_states", &LinearModel::first_order_states)
+      .def("__repr__", [](const LinearModel& l) {
+        return "<rfem.LinearModel " + std::to_string(l.states.size()) + " states, " + std::to_string(l.inputs.size()) + " inputs, " +
+               std::to_string(l.outputs.size()) + " outputs, about " + (l.equilibrium ? "rest" : "the motion") + " at t = " +
+               py::repr(py::float_(l.t)).cast<std::string>() + " s>";
+      });
+  m.def("_linearize", [](py::handle case_arg, py::handle n, py::handle state, py::handle threads, py::handle equilibrium,
+                         py::handle output_arg, const std::string& made_by) {
+    const args::CaseArg cs_arg(case_arg);
+    const Case& cs = *cs_arg;
+    LinearizeRequest rq;
+    rq.n = args::rfes(n);
+    rq.threads = args::threads(threads);
+    rq.equilibrium = args::flag(equilibrium, "equilibrium");
+    if (!state.is_none()) {
+      if (!py::isinstance<SimulationState>(state)) args::type_error("state", "an rfem.SimulationState or None", state);
+      rq.state = std::make_shared<const SimulationState>(state.cast<SimulationState>());
+    }
+    const std::string output = args::path(output_arg, "output", true);
+    py::gil_scoped_release release;
+    auto lin = std::make_shared<LinearModel>(linearize(cs, rq));
+    if (!output.empty()) {
+      ResultsWriter file(output, describe(cs, made_by, "linearize", static_cast<long>(lin->states.size() - lin->inputs.size()) / 6, rq.threads, rq.n));
+      write_linear(file, *lin);
+      file.close();
+    }
+    return lin;
+  }, py::arg("case"), py::arg("n"), py::arg("state"), py::arg("threads"), py::arg("equilibrium"), py::arg("output"), py::arg("made_by"));
 
   m.def("_run_controlled", [](py::handle case_arg, py::handle n, py::handle threads, py::handle output, py::handle keep_series,
                               std::optional<SimulationState> state, const std::string& made_by, py::object controller,

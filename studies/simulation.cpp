@@ -435,6 +435,74 @@ SimulationState Simulation::state() const {
   return s;
 }
 
+LinearModel Simulation::linearize(bool equilibrium) {
+  Impl& m = *impl_;
+  m.require_running("linearize");
+  m.bring_inputs_up_to_date();
+  const IntegratorState x = m.stepper->state();
+  const Model& md = *m.model;
+  EquationsOfMotion& eq = *m.eq;
+  const int N = eq.unknowns();
+  LinearModel lin;
+  lin.t = x.t;
+  lin.equilibrium = equilibrium;
+  const std::vector<std::string> names = coordinate_names();
+  for (int i = 0; i < N; ++i) lin.states.push_back(names[static_cast<size_t>(eq.unknown_index(i))]);
+  std::vector<int> free_rows;
+  for (int j = 0; j < md.m(); ++j)
+    if (eq.base_col()[j] >= 0) {
+      lin.inputs.push_back(md.joints[j].name);
+      free_rows.push_back(eq.base_col()[j]);
+    }
+  for (const MountedLink& L : md.links)
+    for (const char* c : {"tip_u1", "tip_u2", "tip_theta"}) {
+      lin.outputs.push_back(L.name + "/" + c);
+      lin.output_units.push_back(c == std::string("tip_theta") ? "rad" : "m");
+    }
+  for (const Joint& J : md.joints) {
+    const bool turns = J.type == JointType::Revolute;
+    for (const char* c : {"q", "v", "tau"}) lin.outputs.push_back(J.name + "/" + c);
+    lin.output_units.insert(lin.output_units.end(), {turns ? "rad" : "m", turns ? "rad/s" : "m/s", turns ? "N m" : "N"});
+  }
+  if (m.sensors) {
+    const auto c = m.sensors->columns(), u = m.sensors->units();
+    lin.outputs.insert(lin.outputs.end(), c.begin(), c.end());
+    lin.output_units.insert(lin.output_units.end(), u.begin(), u.end());
+  }
+  std::vector<double> out;
+  const LinearEvaluation f = [&](const VecX& qu, const VecX& vu, const VecX& au, VecX& r, VecX& y) {
+    r.resize(N);
+    eq.residual(x.t, qu.data(), vu.data(), au.data(), r.data());
+    const VecX tau = eq.torques(x.t);
+    const VecX q = full(md, eq, m.inputs, qu, x.t, 0), v = full(md, eq, m.inputs, vu, x.t, 1), a = full(md, eq, m.inputs, au, x.t, 2);
+    out.clear();
+    for (size_t l = 0; l < md.links.size(); ++l) {
+      const Vec3 d = tip_deflection(md, static_cast<int>(l), q);
+      out.insert(out.end(), {d[0], d[1], d[2]});
+    }
+    for (int j = 0; j < md.m(); ++j) out.insert(out.end(), {q[md.joint_index(j)], v[md.joint_index(j)], tau[j]});
+    if (m.sensors) m.sensors->read(q, v, a, tau, out, -1);  // (exact: no noise, no quantisation)
+    y = Eigen::Map<const VecX>(out.data(), static_cast<Eigen::Index>(out.size()));
+  };
+  const VecX a0 = equilibrium ? VecX::Zero(N) : x.a;
+  linearize_about(f, x.q, x.v, a0, free_rows, 6 * md.n(), lin);
+  return lin;
+}
+
+LinearModel linearize(const Case& cs, const LinearizeRequest& rq) {
+  Case c = cs;
+  c.sim.options.kind = IntegratorKind::Esdirk;  // (the equations are the integrators' same; only a stepped one starts here)
+  SimulationOptions o;
+  o.n = rq.n;
+  o.threads = rq.threads;
+  o.state = rq.state;
+  Simulation sim(c, std::move(o));
+  if (sim.status().kind != RunStatus::Kind::Running) throw std::runtime_error("cannot linearise: " + sim.status().to_string());
+  LinearModel lin = sim.linearize(rq.equilibrium);
+  sim.finish(RunStatus::interrupted(0));
+  return lin;
+}
+
 RunResult Simulation::finish(std::optional<RunStatus> status) {
   Impl& m = *impl_;
   if (m.result) return *m.result;

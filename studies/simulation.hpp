@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "rfem/studies/linearize.hpp"
 #include "rfem/studies/runs.hpp"
 
 namespace rfem {
@@ -111,6 +112,10 @@ class Simulation {
   Snapshot snapshot();
   /// The state now, to save or to start other simulations from.
   SimulationState state() const;
+  /// The linear model about the state now (studies/linearize.hpp), the laws in force included: at
+  /// rest (`equilibrium`: q̈ = 0, the free joints' inputs u0 those that hold it) or on the motion
+  /// (q̈ the state's own).
+  LinearModel linearize(bool equilibrium = true);
   /// Ends the run with `status` (default: how advance() left it — completed if at t_end, else
   /// interrupted (stopped)), closes the results file and returns the run's record (again on later
   /// calls). Afterwards only the getters work (the rest throws std::logic_error).
@@ -155,5 +160,19 @@ struct ControlOptions {
 /// controller that throws, or returns an unknown joint or a value that is not finite, ends the run
 /// `failed: controller: …` with every earlier row kept.
 RunResult run_controlled(const Case& cs, SimulationOptions opts, const Controller& controller, const ControlOptions& control);
+
+/// What rfem.linearize / `rfem linearize` asks for.
+struct LinearizeRequest {
+  int n = 0;        ///< rfes in all links (0: the case's own)
+  int threads = 1;  ///< the kernels' team
+  /// About this state (its time, the same model only); null: the case's initial state (its static
+  /// equilibrium, simulation.initial = "static") at t = 0.
+  std::shared_ptr<const SimulationState> state;
+  bool equilibrium = true;  ///< q̈ = 0 (at rest) or the state's own accelerations
+};
+/// The case's linear model. CaseError for a case that cannot run (check_runnable, integrator "bdf":
+/// linearised with the ESDIRK equations — the same equations), std::invalid_argument for another
+/// model's state.
+LinearModel linearize(const Case& cs, const LinearizeRequest& rq);
 
 }  // namespace rfem

@@ -27,7 +27,7 @@ import json as _json
 import os as _os
 
 from . import _rfem
-from ._rfem import (MAX_RFES, Case, CaseError, Model, ModesResult, ResultsError, Run, RunStatus, StaticResult, Sweep,
+from ._rfem import (MAX_RFES, Case, CaseError, LinearModel, Model, ModesResult, ResultsError, Run, RunStatus, StaticResult, Sweep,
                     __version__, build)
 
 
@@ -56,7 +56,7 @@ _os.register_at_fork(after_in_child=_rfem._after_fork)
 for _f in (run_point, finished_point, write_index, write_xdmf):
     _f.__doc__ = getattr(_rfem, _f.__name__).__doc__.split("\n", 1)[-1].strip()
 
-__all__ = ["Case", "CaseError", "Frame", "Model", "ModesResult", "ResultsError", "Run", "RunInterrupted", "RunStatus", "Runs",
+__all__ = ["Case", "CaseError", "Frame", "LinearModel", "linearize", "Model", "ModesResult", "ResultsError", "Run", "RunInterrupted", "RunStatus", "Runs",
            "StaticResult", "RefineResult", "Tree", "load", "model", "show", "run", "static", "modes", "refine", "plot",
            "write_xdmf", "animate", "toml_value", "__version__", "Sweep", "SweepResult", "load_sweep", "sweep", "run_point",
            "finished_point", "write_index"]
@@ -366,6 +366,23 @@ def __getattr__(name):
 
 def __dir__():
     return sorted(set(globals()) | {"plots", "animate"})
+
+
+def linearize(case, n=None, state=None, threads=1, equilibrium=True, output=None):
+    """The case's linear model (an rfem.LinearModel) about its initial state — the static equilibrium
+    of simulation.initial = "static" at t = 0 — or about `state` (an rfem.SimulationState: the same
+    model, its time), at rest (equilibrium=True: accelerations zero, u0 the torques that hold it) or on
+    the motion:
+
+        M q'' + D q' + K q = B u,   y = Cq q + Cv q' + Ca q''   (deviations, SI units)
+
+    over the unknowns (`states`: rfe coordinates and free joints; prescribed joints held on their
+    motion, their torque an output), inputs u a torque added at each free joint, outputs every link's
+    tip deflection, every joint's q, v, tau and the case's sensors. By central differences of the
+    equations the integrators solve (the case's laws, PD gains included). lin.state_space() gives
+    (A, B, C, D) for x = (q, q'). `output`: an HDF5 file (group "linear": every matrix with its row
+    and column names; MATLAB's h5read, h5py, SciPy read it), as `rfem linearize -o`."""
+    return _rfem._linearize(case, n, state, threads, equilibrium, output, "rfem.linearize (Python)")
 
 
 # A simulation a script steps and controllers in the loop (python/rfem/simulation.py).

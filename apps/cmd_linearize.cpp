@@ -1,0 +1,76 @@
+// `rfem linearize`: the case's linear model (M, D, K, B, C and A, B, C, D with their names) about
+// its initial equilibrium or a saved state, into HDF5; prints its size and lowest frequencies.
+#include <fmt/core.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+#include "commands.hpp"
+#include "rfem/results/errors.hpp"
+#include "rfem/studies/recorders.hpp"
+#include "rfem/studies/simulation.hpp"
+
+namespace rfem::app {
+
+int run_linearize(const Common& c, const LinearizeOptions& o) {
+  const Case cs = read_checked_case(c);
+  LinearizeRequest rq;
+  rq.n = c.n;
+  rq.threads = c.threads > 0 ? c.threads : 1;
+  rq.equilibrium = !o.on_motion;
+  if (!o.state.empty()) {
+    try {
+      rq.state = std::make_shared<const SimulationState>(load_state(o.state));
+    } catch (const std::exception& e) {
+      throw CaseError(std::string("--state: ") + e.what());  // (its message names the file)
+    }
+  }
+  LinearModel lin;
+  try {
+    lin = linearize(cs, rq);
+  } catch (const std::invalid_argument& e) {  // another model's state
+    throw CaseError("--state: " + o.state + ": " + e.what());
+  }
+  {
+    ResultsWriter file(o.output, describe(cs, c.command_line, "linearize",
+                                          static_cast<long>(lin.states.size() - lin.inputs.size()) / 6, rq.threads, c.n));
+    write_linear(file, lin);
+    file.close();
+  }
+  // The first-order model's eigenvalues: frequencies [Hz] and damping ratios of its lowest modes.
+  MatX A, B, C, D;
+  lin.state_space(A, B, C, D);
+  const Eigen::VectorXcd ev = Eigen::EigenSolver<MatX>(A, false).eigenvalues();
+  std::vector<std::pair<double, double>> modes;  // (f [Hz], ζ) of each pair with ω > 0
+  for (Eigen::Index i = 0; i < ev.size(); ++i)
+    if (ev[i].imag() > 0) modes.emplace_back(std::abs(ev[i]) / (2 * M_PI), -ev[i].real() / std::abs(ev[i]));
+  std::sort(modes.begin(), modes.end());
+  const int shown = std::min<int>(static_cast<int>(modes.size()), 6);
+  if (c.json) {
+    nlohmann::json f = nlohmann::json::array(), z = nlohmann::json::array();
+    for (int i = 0; i < shown; ++i) {
+      f.push_back(modes[static_cast<size_t>(i)].first);
+      z.push_back(modes[static_cast<size_t>(i)].second);
+    }
+    print_json({{"command", "linearize"}, {"case", cs.path}, {"output", o.output}, {"t", lin.t},
+                {"about", lin.equilibrium ? "equilibrium" : "state"}, {"states", lin.states.size()},
+                {"inputs", lin.inputs}, {"outputs", lin.outputs.size()}, {"imbalance", lin.imbalance},
+                {"frequencies_hz", f}, {"damping_ratios", z}});
+    return 0;
+  }
+  if (c.quiet) return 0;
+  std::string inputs;
+  for (const auto& s : lin.inputs) inputs += (inputs.empty() ? "" : ", ") + s;
+  fmt::print("linear model of {} about {} at t = {:g} s: {} states ({} first order), {} inputs ({}), {} outputs\n",
+             cs.name.empty() ? cs.path : cs.name, lin.equilibrium ? "rest" : "the motion", lin.t, lin.states.size(),
+             2 * lin.states.size(), lin.inputs.size(), inputs.empty() ? "none: every joint prescribed" : inputs,
+             lin.outputs.size());
+  for (int i = 0; i < shown; ++i)
+    fmt::print("  mode {}: {:.6g} Hz, damping ratio {:.3g}\n", i + 1, modes[static_cast<size_t>(i)].first,
+               modes[static_cast<size_t>(i)].second);
+  fmt::print("wrote {} (group linear: M, D, K, B, Cq, Cv, Ca, A, Bs, C, Ds)\n", o.output);
+  return 0;
+}
+
+}  // namespace rfem::app
