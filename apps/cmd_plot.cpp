@@ -81,4 +81,6 @@ int run_plot(const std::string& results, const std::string& outdir, const std::s
 
 int run_animate(const std::vector<std::string>& args) { return run_module("animate", args); }
 
+int run_bode(const std::vector<std::string>& args) { return run_module("linear", args); }
+
 }  // namespace rfem::app

@@ -81,6 +81,8 @@ int run_plot(const std::string& results, const std::string& outdir, const std::s
 
 /// `rfem animate RESULTS.h5 …`: the arm moving, as MP4 or GIF (options passed to python3 -m rfem.animate).
 int run_animate(const std::vector<std::string>& args);
+/// `rfem bode LIN.h5 --input J --output Y [-o FILE]`: a linear model's Bode plot (python3 -m rfem.linear).
+int run_bode(const std::vector<std::string>& args);
 /// `rfem view RESULTS.h5 [--run R]`: XDMF files for ParaView beside the results file.
 int run_view(const std::string& results, const std::vector<std::string>& runs);
 

@@ -135,6 +135,12 @@ int main(int argc, char** argv) {
   an->add_option("--view", anim_view, "3d (default), xy, xz or yz")->check(CLI::IsMember({"3d", "xy", "xz", "yz"}));
   an->add_option("--fps", anim_fps, "frames per second (default 25)")->check(kPositiveInt);
   an->add_option("--frames", anim_frames, "at most this many frames, the stored steps thinned evenly (default 300)")->check(kPositiveInt);
+  auto* bd = app.add_subcommand("bode", "the Bode plot of a linear model file (rfem linearize -o) from a joint's torque to an output");
+  std::string bode_file, bode_in, bode_out, bode_fig;
+  bd->add_option("linear", bode_file, "linear model file (HDF5) from rfem linearize")->required();
+  bd->add_option("--input", bode_in, "a free joint (the torque added there)")->required();
+  bd->add_option("--output", bode_out, "an output: LINK/tip_u1, JOINT/q, a sensor column, …")->required();
+  bd->add_option("-o,--out", bode_fig, "the figure (default: LIN.INPUT.OUTPUT.png beside the file; .pdf, .svg by extension)");
   auto* rf = app.add_subcommand("refine", "convergence tables of quantities over a series of n");
   add_common(rf, false);
   RefineOptions ro;
@@ -172,7 +178,7 @@ int main(int argc, char** argv) {
     bool known = false;
     for (const auto* sub : app.get_subcommands([](const CLI::App*) { return true; })) known |= sub->get_name() == w;
     if (!known) {
-      print_line(fmt::format("rfem: error: unknown command '{}' (show, static, modes, linearize, run, refine, sweep, plot, view, animate; rfem --help)", w));
+      print_line(fmt::format("rfem: error: unknown command '{}' (show, static, modes, linearize, bode, run, refine, sweep, plot, view, animate; rfem --help)", w));
       return 2;
     }
   }
@@ -201,6 +207,11 @@ int main(int argc, char** argv) {
     if (st->parsed()) return run_static(common, mo);
     if (md->parsed()) return run_modes(common, mo);
     if (ln->parsed()) return run_linearize(common, lo);
+    if (bd->parsed()) {
+      std::vector<std::string> args{bode_file, "--input", bode_in, "--output", bode_out};
+      if (!bode_fig.empty()) args.insert(args.end(), {"-o", bode_fig});
+      return run_bode(args);
+    }
     if (pl->parsed()) return run_plot(plot_file, plot_dir, plot_format, paper_signs);
     if (vw->parsed()) return run_view(view_file, view_runs);
     if (an->parsed()) {

@@ -358,14 +358,14 @@ def __getattr__(name):
     # rfem.plots and rfem.animate: modules imported when first used (matplotlib and h5py load then).
     # rfem.animate is callable: rfem.animate(results, output=None, run=None, scale=None, view="3d",
     # fps=25, frames=300) writes the film and returns its path (python/rfem/animate.py).
-    if name in ("plots", "animate"):
+    if name in ("plots", "animate", "linear"):
         import importlib
         return importlib.import_module("." + name, __name__)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def __dir__():
-    return sorted(set(globals()) | {"plots", "animate"})
+    return sorted(set(globals()) | {"plots", "animate", "linear"})
 
 
 def linearize(case, n=None, state=None, threads=1, equilibrium=True, output=None):
@@ -383,6 +383,16 @@ def linearize(case, n=None, state=None, threads=1, equilibrium=True, output=None
     (A, B, C, D) for x = (q, q'). `output`: an HDF5 file (group "linear": every matrix with its row
     and column names; MATLAB's h5read, h5py, SciPy read it), as `rfem linearize -o`."""
     return _rfem._linearize(case, n, state, threads, equilibrium, output, "rfem.linearize (Python)")
+
+
+def _frequency_response(self, frequencies, input=None, output=None):
+    """G(j2πf) for f in `frequencies` [Hz] (rfem.linear.frequency_response): complex, shape
+    (len f, outputs, inputs), or (len f,) for one named input and output."""
+    from .linear import frequency_response
+    return frequency_response(self, frequencies, input, output)
+
+
+LinearModel.frequency_response = _frequency_response
 
 
 # A simulation a script steps and controllers in the loop (python/rfem/simulation.py).
