@@ -492,6 +492,7 @@ LinearModel Simulation::linearize(bool equilibrium) {
 LinearModel linearize(const Case& cs, const LinearizeRequest& rq) {
   Case c = cs;
   c.sim.options.kind = IntegratorKind::Esdirk;  // (the equations are the integrators' same; only a stepped one starts here)
+  c.has_simulation = true;  // (a linear model needs no [simulation]: its defaults, from t = 0)
   SimulationOptions o;
   o.n = rq.n;
   o.threads = rq.threads;
