@@ -22,8 +22,18 @@ namespace rfem::app {
 namespace {
 namespace fs = std::filesystem;
 
+const char* python() { return fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3"; }
+
+// Whether Python finds rfem.MODULE on its own path (an installed package).
+bool python_finds(const std::string& module) {
+  const std::string cmd = std::string(python()) + " -c 'import importlib.util, sys; sys.exit(importlib.util.find_spec(\"rfem." +
+                          module + "\") is None)' >/dev/null 2>&1";
+  return std::system(cmd.c_str()) == 0;
+}
+
 // The directory holding the package rfem (with rfem/MODULE.py): $RFEM_PYTHONPATH, or the first of
-// RFEM_PYTHON_DIRS beside the program that has it.
+// RFEM_PYTHON_DIRS beside the program that has it, or "" when there is none but Python finds an
+// installed one (a build without the module, e.g. the sanitizer build, after an install).
 std::string package_parent(const std::string& module) {
   std::error_code ec;
   if (const char* e = std::getenv("RFEM_PYTHONPATH"); e && *e) {
@@ -42,6 +52,7 @@ std::string package_parent(const std::string& module) {
     if (fs::exists(clean / "rfem" / (module + ".py"), ec)) return clean.string();
     looked += (looked.empty() ? "" : ", ") + clean.string();
   }
+  if (python_finds(module)) return "";
   throw std::runtime_error("the Python package rfem (rfem/" + module + ".py) is not beside the program (looked in " +
                            looked + "); set RFEM_PYTHONPATH to the directory that holds rfem/");
 }
@@ -49,18 +60,17 @@ std::string package_parent(const std::string& module) {
 // Runs /usr/bin/python3 -m rfem.MODULE ARGS with the package on PYTHONPATH; its exit code.
 int run_module(const std::string& module, const std::vector<std::string>& module_args) {
   const std::string parent = package_parent(module);
-  const char* python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  std::vector<std::string> args{python, "-m", "rfem." + module};
+  std::vector<std::string> args{python(), "-m", "rfem." + module};
   args.insert(args.end(), module_args.begin(), module_args.end());
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   const char* old = std::getenv("PYTHONPATH");
-  const std::string path = parent + (old && *old ? ":" + std::string(old) : "");
+  const std::string path = parent.empty() ? std::string(old ? old : "") : parent + (old && *old ? ":" + std::string(old) : "");
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error("cannot start python3 -m rfem." + module);
   if (pid == 0) {
-    setenv("PYTHONPATH", path.c_str(), 1);
+    if (!path.empty()) setenv("PYTHONPATH", path.c_str(), 1);
     setenv("PYTHONSAFEPATH", "1", 1);  // not the current directory first on sys.path (an rfem/ there)
     execvp(argv[0], argv.data());
     _exit(127);
