@@ -10,7 +10,7 @@ prefix="$here/.deps/sundials"
 pkgs=(build-essential cmake ninja-build pkg-config dpkg-dev ca-certificates
       libeigen3-dev libsuitesparse-dev libhdf5-dev hdf5-tools libtomlplusplus-dev libcli11-dev
       libfmt-dev libspdlog-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libspectra-dev
-      python3 python3-dev python3-numpy python3-h5py python3-matplotlib python3-pytest pybind11-dev
+      python3 python3-dev python3-numpy python3-scipy python3-h5py python3-matplotlib python3-pytest pybind11-dev
       python3-venv python3-pip python3-setuptools python3-wheel python3-mypy
       python3-nbclient python3-nbformat python3-ipykernel
       liburdfdom-dev libopenmpi-dev openmpi-bin clang libclang-rt-14-dev libomp-14-dev)
