@@ -24,9 +24,10 @@ namespace fs = std::filesystem;
 
 const char* python() { return fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3"; }
 
-// Whether Python finds rfem.MODULE on its own path (an installed package).
+// Whether Python finds rfem.MODULE on its own path (an installed package; -P: not in the current
+// directory, as the module runs with PYTHONSAFEPATH).
 bool python_finds(const std::string& module) {
-  const std::string cmd = std::string(python()) + " -c 'import importlib.util, sys; sys.exit(importlib.util.find_spec(\"rfem." +
+  const std::string cmd = std::string(python()) + " -P -c 'import importlib.util, sys; sys.exit(importlib.util.find_spec(\"rfem." +
                           module + "\") is None)' >/dev/null 2>&1";
   return std::system(cmd.c_str()) == 0;
 }
