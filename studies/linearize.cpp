@@ -7,6 +7,7 @@
 
 #include "rfem/results/reader.hpp"
 #include "rfem/results/writer.hpp"
+#include "rfem/studies/simulation.hpp"
 
 namespace rfem {
 
@@ -128,9 +129,9 @@ void write_linear(ResultsWriter& file, const LinearModel& lin) {
   if (inputs) put("Bs", Bs, x, lin.inputs, "first order input matrix");
   put("C", C, lin.outputs, x, "first order: y = C x + Ds u");
   if (inputs) put("Ds", Ds, lin.outputs, lin.inputs, "first order feed-through");
-  MatX op(4, lin.q0.size());
-  op << lin.q0.transpose(), lin.v0.transpose(), lin.a0.transpose(), VecX::Zero(lin.q0.size()).transpose();
-  put("operating_point", op.topRows(3), {"q", "v", "a"}, lin.states, "the state linearised about (unknowns)");
+  MatX op(3, lin.q0.size());
+  op << lin.q0.transpose(), lin.v0.transpose(), lin.a0.transpose();
+  put("operating_point", op, {"q", "v", "a"}, lin.states, "the state linearised about (unknowns)");
   put("y0", lin.y0.transpose(), {"y0"}, lin.outputs, "the outputs there");
   if (inputs)
     file.write_table("linear/u0", table_of(lin.u0.transpose()), lin.inputs, std::vector<std::string>(lin.inputs.size(), ""),
@@ -144,6 +145,21 @@ void write_linear(ResultsWriter& file, const LinearModel& lin) {
   file.write_attribute("linear", "inputs", lin.inputs.empty() ? std::vector<std::string>{"(none)"} : lin.inputs);
   file.write_attribute("linear", "outputs", lin.outputs);
   file.write_attribute("linear", "output_units", lin.output_units);
+}
+
+LinearModel linearize(const Case& cs, const LinearizeRequest& rq) {
+  Case c = cs;
+  c.sim.options.kind = IntegratorKind::Esdirk;  // (the equations are the integrators' same; only a stepped one starts here)
+  c.has_simulation = true;  // (a linear model needs no [simulation]: its defaults, from t = 0)
+  SimulationOptions o;
+  o.n = rq.n;
+  o.threads = rq.threads;
+  o.state = rq.state;
+  Simulation sim(c, std::move(o));
+  if (sim.status().kind != RunStatus::Kind::Running) throw std::runtime_error("cannot linearise: " + sim.status().to_string());
+  LinearModel lin = sim.linearize(rq.equilibrium);
+  sim.finish(RunStatus::interrupted(0));
+  return lin;
 }
 
 }  // namespace rfem

@@ -489,21 +489,6 @@ LinearModel Simulation::linearize(bool equilibrium) {
   return lin;
 }
 
-LinearModel linearize(const Case& cs, const LinearizeRequest& rq) {
-  Case c = cs;
-  c.sim.options.kind = IntegratorKind::Esdirk;  // (the equations are the integrators' same; only a stepped one starts here)
-  c.has_simulation = true;  // (a linear model needs no [simulation]: its defaults, from t = 0)
-  SimulationOptions o;
-  o.n = rq.n;
-  o.threads = rq.threads;
-  o.state = rq.state;
-  Simulation sim(c, std::move(o));
-  if (sim.status().kind != RunStatus::Kind::Running) throw std::runtime_error("cannot linearise: " + sim.status().to_string());
-  LinearModel lin = sim.linearize(rq.equilibrium);
-  sim.finish(RunStatus::interrupted(0));
-  return lin;
-}
-
 RunResult Simulation::finish(std::optional<RunStatus> status) {
   Impl& m = *impl_;
   if (m.result) return *m.result;
