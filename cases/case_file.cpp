@@ -1,4 +1,5 @@
 #include "rfem/cases/case_file.hpp"
+#include "rfem/solvers/modes.hpp"
 
 #include <algorithm>
 #include <filesystem>
@@ -293,6 +294,11 @@ Model build_model(const Case& c, int n) {
       throw CaseError(c.path + ": " + c.links[l].key + ": " + e.what());
     }
     ml.on = c.links[l].on;
+    ml.d.modes = c.links[l].modes;
+    if (ml.d.modes > kModalAxes * ml.d.n())
+      throw CaseError(c.path + (c.links[l].modes_line > 0 ? ":" + std::to_string(c.links[l].modes_line) : std::string(" (--set or missing)")) + ": " +
+                      c.links[l].key + ".modes: " + std::to_string(ml.d.modes) + " modes, but n = " + std::to_string(ml.d.n()) +
+                      " rfes have only " + std::to_string(kModalAxes * ml.d.n()) + " to keep (5 per rfe: the axial ones stay)");
     links.push_back(std::move(ml));
   }
   try {

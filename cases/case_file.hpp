@@ -65,6 +65,8 @@ struct LinkCase {
   std::string key;   ///< where its keys are: "link" or "links.i" (messages)
   FlexibleLink link;
   int n = 0;         ///< its n if given (0: each segment's parts)
+  int modes = 0;     ///< modal reduction: modes kept (0: every rfe coordinate; solvers/reduction.hpp)
+  int modes_line = 0;  ///< where `modes` is written (messages; 0: not in the file)
   Mounting on;       ///< what it sits on (resolved; default: the last joint)
 };
 

@@ -10,13 +10,15 @@ namespace {
 
 LinkCase read_link(const Reader& r, const toml::table& lt, const std::string& key, const std::string& name,
                    const Materials& mats, const Sections& secs, ParentRef& parent) {
-  r.check_keys(lt, key, {"name", "parent", "at", "n", "damping_beta", "mount", "segments", "payloads"});
+  r.check_keys(lt, key, {"name", "parent", "at", "n", "modes", "damping_beta", "mount", "segments", "payloads"});
   LinkCase c;
   c.key = key;
   c.name = r.string(lt, key, "name", name);
   if (const std::string why = name_problem(c.name); !why.empty()) r.fail(lt.get("name"), key + ".name", why);
   c.n = static_cast<int>(r.integer(lt, key, "n", 0, 1, kMaxRfes));
   c.link.damping_beta = r.non_negative(lt, key, "damping_beta", 0.0);
+  c.modes = static_cast<int>(r.integer(lt, key, "modes", 0, 0, 6 * kMaxRfes));
+  c.modes_line = lt.get("modes") ? static_cast<int>(lt.get("modes")->source().begin.line) : 0;
   parent.path = key;
   parent.node = lt.get("parent") ? lt.get("parent") : &lt;
   parent.name = r.string(lt, key, "parent", std::string());

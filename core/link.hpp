@@ -61,6 +61,9 @@ struct Discretisation {
   double length = 0.0;
   double damping_beta = 0.0;
   std::vector<Payload> payloads;  ///< (their inertia is in the rfes; kept for their positions)
+  /// Modal reduction (solvers/reduction.hpp): keep the link's first `modes` clamped modes instead
+  /// of its 6n rfe coordinates; 0 keeps every coordinate.
+  int modes = 0;
   int n() const { return static_cast<int>(rfes.size()); }
   /// Its rigid counterpart (n = 0): no rfes, rfe_0 the whole link's inertia about {r}'s origin.
   Discretisation rigid() const;

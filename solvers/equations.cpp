@@ -50,7 +50,17 @@ EquationsOfMotion::EquationsOfMotion(std::shared_ptr<const Model> model_ptr, std
       base_col_[j] = static_cast<int>(unknown_.size());
       unknown_.push_back(model.joint_index(j));
     }
-  newton_ = std::make_unique<NewtonSystem>(model_, base_col_, solver, keep_stiffness);
+  nu_ = static_cast<int>(unknown_.size());
+  ubase_col_ = base_col_;
+  VecX qb(model.m());  // the reduced links' modes: at the joints' initial values
+  for (int j = 0; j < model.m(); ++j) qb[j] = inputs[j].prescribed() ? inputs[j].motion->at(0.0).q : inputs[j].q0;
+  reduction_ = Reduction::of(model, qb);
+  if (reduction_) {
+    nu_ = reduction_->rfe() + (nu_ - n6);
+    for (int& c : ubase_col_)
+      if (c >= 0) c += reduction_->rfe() - n6;
+  }
+  newton_ = std::make_unique<NewtonSystem>(model_, base_col_, solver, keep_stiffness, reduction_);
   std::vector<double> kp, kd;  // feedback laws stiffen and damp their joints (in column order)
   bool feedback = false;
   for (int j = 0; j < model.m(); ++j)
@@ -64,9 +74,21 @@ EquationsOfMotion::EquationsOfMotion(std::shared_ptr<const Model> model_ptr, std
 
 void EquationsOfMotion::expand(double t, const double* qu, const double* vu, const double* au) {
   RFEM_CHECK_ARGUMENT(unknowns() == 0 || (qu && vu), "qu and vu must point to unknowns() values");
+  if (reduction_) {  // the full unknowns first: q0 + P q_u, P v_u, P a_u
+    const int U = static_cast<int>(unknown_.size()), k = U - model_->flexible_dofs();
+    qf_.resize(U);
+    vf_.resize(U);
+    af_.resize(U);
+    reduction_->lift(qu, qf_.data(), k, true);
+    reduction_->lift(vu, vf_.data(), k, false);
+    if (au) reduction_->lift(au, af_.data(), k, false);
+    qu = qf_.data();
+    vu = vf_.data();
+    au = au ? af_.data() : nullptr;
+  }
   // Every coordinate is set below: the rfes' are the first unknowns, in order (the constructor), and
   // every joint is either prescribed or unknown.
-  const int N = model_->dof(), u = unknowns(), n6 = model_->flexible_dofs();
+  const int N = model_->dof(), u = static_cast<int>(unknown_.size()), n6 = model_->flexible_dofs();
   q_.resize(N);
   v_.resize(N);
   a_.resize(N);
@@ -108,12 +130,15 @@ Power EquationsOfMotion::residual(double t, const double* qu, const double* vu, 
     ws_.parallel.threads = governor_.threads();
   }
   const VecX tau = torques(t);
-  const int u = unknowns(), m = model_->m();
+  const int u = static_cast<int>(unknown_.size()), m = model_->m();
   const int n6 = model_->flexible_dofs();  // the first unknowns, in order
-  Eigen::Map<VecX>(r, n6) = F_.head(n6);
-  for (int i = n6; i < u; ++i) r[i] = F_[unknown_[i]];
+  if (reduction_) rf_.resize(u);
+  double* full = reduction_ ? rf_.data() : r;
+  Eigen::Map<VecX>(full, n6) = F_.head(n6);
+  for (int i = n6; i < u; ++i) full[i] = F_[unknown_[i]];
   for (int j = 0; j < m; ++j)
-    if (base_col_[j] >= 0) r[base_col_[j]] -= tau[j];
+    if (base_col_[j] >= 0) full[base_col_[j]] -= tau[j];
+  if (reduction_) reduction_->project(full, r, u - n6);  // Galerkin: r_η = Φᵀ r_l
   p.input = tau.dot(model_->joint_coords(v_));
   return p;
 }
@@ -127,7 +152,7 @@ Power EquationsOfMotion::power_change(double t, const double* vu, const VecX& da
     if (inputs_[j].prescribed()) d.input += inputs_[j].motion->at(t).qd * rows.row(j).dot(da);
     else {  // P = τ(t, q, v) v with δv = hγ δa, δq = (hγ)² δa
       const TorqueLaw& law = *inputs_[j].torque;
-      const double vj = vu[base_col_[j]], dq = hg * hg * da[base_col_[j]], dv = hg * da[base_col_[j]];
+      const double vj = vu[ubase_col_[j]], dq = hg * hg * da[ubase_col_[j]], dv = hg * da[ubase_col_[j]];
       d.input += law.at(t, q_[model_->joint_index(j)], vj) * dv - (law.stiffness() * dq + law.damping() * dv) * vj;
     }
   }
@@ -137,7 +162,7 @@ Power EquationsOfMotion::power_change(double t, const double* vu, const VecX& da
     d.dissipation = 2.0 * hg * Eigen::Map<const VecX>(vu, unknowns()).dot(Cda);
   }
   for (int j = 0; j < model_->m(); ++j)  // the drives' power, not a quadratic form when they have friction
-    if (base_col_[j] >= 0) d.dissipation += model_->joints[j].drive.power_derivative(vu[base_col_[j]]) * hg * da[base_col_[j]];
+    if (ubase_col_[j] >= 0) d.dissipation += model_->joints[j].drive.power_derivative(vu[ubase_col_[j]]) * hg * da[ubase_col_[j]];
   return d;
 }
 
@@ -146,7 +171,7 @@ VecX EquationsOfMotion::accelerations(double t, const double* qu, const double* 
   VecX rhs(u);
   residual(t, qu, vu, nullptr, rhs.data());
   rhs = -rhs;
-  if (!solve_mass(*model_, newton_->pattern(), base_col_, q_, v_, rhs, mass_values_, &ws_))
+  if (!newton_->solve_mass(q_, v_, rhs, mass_values_, ws_))
     throw std::runtime_error("the mass matrix is not positive definite at t = " + std::to_string(t) + " s");
   std::vector<double>().swap(mass_values_);  // needed once or at output times: do not keep it
   return rhs;
@@ -205,14 +230,23 @@ std::vector<double> EquationsOfMotion::breakpoints(double t_end) const {
 }
 
 void EquationsOfMotion::initial_state(VecX& qu, VecX& vu, bool static_equilibrium) const {
-  qu = VecX::Zero(unknowns());
-  vu = VecX::Zero(unknowns());
+  qu = VecX::Zero(static_cast<long>(unknown_.size()));  // the full unknowns, reduced at the end
+  vu = VecX::Zero(static_cast<long>(unknown_.size()));
+  const auto reduce = [&] {
+    if (!reduction_) return;
+    VecX q(nu_), v(nu_);
+    const int k = static_cast<int>(unknown_.size()) - model_->flexible_dofs();
+    reduction_->restrict(qu.data(), q.data(), k, true);
+    reduction_->restrict(vu.data(), v.data(), k, false);
+    qu = std::move(q);
+    vu = std::move(v);
+  };
   for (int j = 0; j < model_->m(); ++j)
     if (base_col_[j] >= 0) {
       qu[base_col_[j]] = inputs_[j].q0;
       vu[base_col_[j]] = inputs_[j].v0;
     }
-  if (!static_equilibrium || model_->n() == 0) return;
+  if (!static_equilibrium || model_->n() == 0) return reduce();
   VecX qb(model_->m()), vb(model_->m());
   for (int j = 0; j < model_->m(); ++j) {
     const bool law = inputs_[j].prescribed();
@@ -221,8 +255,37 @@ void EquationsOfMotion::initial_state(VecX& qu, VecX& vu, bool static_equilibriu
   }
   StaticOptions so;
   so.parallel = ws_.parallel;  // (the run's threads, also here)
+  so.reduction = reduction_.get();
   const StaticResult eq = solve_static(*model_, qb, vb, TipLoads{}, so);
   qu.head(model_->flexible_dofs()) = eq.q.head(model_->flexible_dofs());
+  reduce();
+}
+
+VecX EquationsOfMotion::full_coordinates(double t, const double* xu, int order) const {
+  VecX x = VecX::Zero(model_->dof());
+  VecX lifted;
+  if (reduction_ && nu_ > 0) {
+    lifted.resize(static_cast<long>(unknown_.size()));
+    reduction_->lift(xu, lifted.data(), static_cast<int>(unknown_.size()) - model_->flexible_dofs(), order == 0);
+    xu = lifted.data();
+  }
+  for (size_t i = 0; i < unknown_.size(); ++i) x[unknown_[i]] = xu[i];
+  for (int j = 0; j < model_->m(); ++j)
+    if (inputs_[j].prescribed()) {
+      const MotionSample s = inputs_[j].motion->at(t);
+      x[model_->joint_index(j)] = order == 0 ? s.q : order == 1 ? s.qd : s.qdd;
+    }
+  return x;
+}
+
+std::vector<std::string> EquationsOfMotion::unknown_names(const std::vector<std::string>& names) const {
+  RFEM_CHECK_ARGUMENT_SIZE(names.size(), model_->dof(), "coordinate names");
+  std::vector<std::string> out;
+  if (reduction_) out = reduction_->names(*model_, names);
+  else
+    for (int i = 0; i < model_->flexible_dofs(); ++i) out.push_back(names[i]);
+  for (size_t i = model_->flexible_dofs(); i < unknown_.size(); ++i) out.push_back(names[unknown_[i]]);
+  return out;
 }
 
 }  // namespace rfem

@@ -6,7 +6,9 @@
 // and the required torques of prescribed joints are the base rows of F (inverse dynamics).
 // Shared by every time integrator; owns the Newton system on the unknowns' bordered pattern and
 // the workspace of its kernels, shares the model and keeps its own copy of the inputs (their laws
-// are shared). Movable, not copyable.
+// are shared). With reduced links (solvers/reduction.hpp, built at the joints' initial values) the
+// unknowns are the reduced ones: every method's q_u, v_u, a_u, r_u and base_col() are then over
+// them, and the full coordinates are q0 + P q_u. Movable, not copyable.
 #include <memory>
 
 #include "rfem/assembly/assemble.hpp"
@@ -51,11 +53,16 @@ class EquationsOfMotion {
   const Model& model() const { return *model_; }
   const std::vector<JointInput>& inputs() const { return inputs_; }
   /// Number of unknown coordinates (size of q_u).
-  int unknowns() const { return static_cast<int>(unknown_.size()); }
-  /// Full coordinate index of unknown i.
-  int unknown_index(int i) const { return unknown_[i]; }
+  int unknowns() const { return nu_; }
   /// Joint j's column among the unknowns, −1 if prescribed.
-  const std::vector<int>& base_col() const { return base_col_; }
+  const std::vector<int>& base_col() const { return ubase_col_; }
+  /// The modal reduction of the model's reduced links (null if none).
+  const std::shared_ptr<const Reduction>& reduction() const { return reduction_; }
+  /// Every coordinate (order 0), rate (1) or acceleration (2) at t from the unknowns' values `xu`
+  /// and the prescribed joints' laws.
+  VecX full_coordinates(double t, const double* xu, int order) const;
+  /// The unknowns' names from every coordinate's (model order): reduced links' η as LINK/etaK.
+  std::vector<std::string> unknown_names(const std::vector<std::string>& coordinate_names) const;
   bool stop_requested() const { return stop_.requested(); }
   const StopToken& stop() const { return stop_; }
 
@@ -108,7 +115,11 @@ class EquationsOfMotion {
   Workspace ws_;
   ThreadGovernor governor_;
   bool by_steps_ = false;
-  std::vector<int> unknown_, base_col_;
+  std::vector<int> unknown_, base_col_;  // the full unknowns (every rfe coordinate, free joints)
+  std::shared_ptr<const Reduction> reduction_;
+  int nu_ = 0;
+  std::vector<int> ubase_col_;  // base_col_ among the (reduced) unknowns
+  VecX qf_, vf_, af_, rf_;      // reduced: the full unknowns' values
   std::unique_ptr<NewtonSystem> newton_;
   std::vector<double> mass_values_;
   VecX q_, v_, a_, F_;

@@ -2,6 +2,8 @@
 
 #include <Spectra/SymEigsShiftSolver.h>
 #include <Spectra/SymGEigsShiftSolver.h>
+#include <Spectra/MatOp/SparseSymMatProd.h>
+#include <Spectra/MatOp/SymShiftInvert.h>
 
 #include <algorithm>
 #include <set>
@@ -11,7 +13,9 @@
 #include "rfem/assembly/assemble.hpp"
 #include "rfem/assembly/rfe_kernels.hpp"
 #include "rfem/solvers/cholmod_solver.hpp"
+#include "rfem/solvers/reduction.hpp"
 #include "rfem/solvers/statics.hpp"
+#include "rfem/core/check.hpp"
 
 namespace rfem {
 
@@ -194,12 +198,101 @@ void separate_degenerate(const VecX& lambda, MatX& shapes, VecX& uncertainty, co
 
 }  // namespace
 
+namespace {
+ModesResult modes_of(const Model& model, const VecX& qb, const VecX& vb, int count, int dense_limit,
+                     const std::vector<int>& free);
+// K of the modal problem: elastic with its geometric term, gravity, centrifugal at the rates vb.
+MatrixTerms stiffness_terms(const VecX& vb) {
+  MatrixTerms terms;
+  terms.stiffness = 1.0;
+  terms.gravity = true;
+  terms.inertial = vb.size() > 0 && vb.norm() > 0.0;
+  return terms;
+}
+ModesResult reduced_modes(const Model& model, const Reduction& red, const VecX& qb, const VecX& vb, int count,
+                          const std::vector<int>& free);
+}  // namespace
+
 ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, int count, int dense_limit,
                           const std::vector<int>& free) {
-  const int n = model.n(), nf = static_cast<int>(free.size()), N = model.flexible_dofs() + nf;
-  if (n == 0) throw std::invalid_argument("modal analysis needs a flexible link (n ≥ 1)");
+  if (model.n() == 0) throw std::invalid_argument("modal analysis needs a flexible link (n ≥ 1)");
   for (const MountedLink& L : model.links)
     if (L.n() == 0) throw std::invalid_argument("modal analysis needs every link flexible (link " + L.name + " has n = 0)");
+  RFEM_CHECK_ARGUMENT_SIZE(qb.size(), model.m(), "qb (joint values)");
+  if (const auto red = Reduction::of(model, qb)) return reduced_modes(model, *red, qb, vb, count, free);
+  return modes_of(model, qb, vb, count, dense_limit, free);
+}
+
+LinkModes link_modes(const Model& model, int l, const VecX& qb, int count) {
+  RFEM_CHECK_INDEX(l, model.links.size(), "link");
+  const MountedLink& L = model.links[l];
+  const int n = L.n(), N = kModalAxes * n;
+  if (count < 1 || count > N)
+    throw std::invalid_argument("link " + L.name + ": modes = " + std::to_string(count) + " must be between 1 and its 5n = " +
+                                std::to_string(N) + " coordinates other than the axial ones");
+  std::vector<MountedLink> links;  // this link alone flexible (and not reduced), the others rigid
+  for (size_t i = 0; i < model.links.size(); ++i) {
+    MountedLink r;
+    r.name = model.links[i].name;
+    r.d = static_cast<int>(i) == l ? model.links[i].d : model.links[i].d.rigid();
+    r.d.modes = 0;
+    r.on = model.links[i].on;
+    links.push_back(std::move(r));
+  }
+  const Model sub = make_model(model.joints, std::move(links), model.gravity, model.free_base);
+  // The first count modes that are not axial (the axial coordinates are unknowns of their own, and
+  // an axial mode without its x1 rows is next to nothing), and one more: a cut through equal
+  // frequencies is refused.
+  const int N6 = Model::rfe_dofs * n;
+  ModesResult all;
+  std::vector<int> pick;
+  for (int want = std::min(N6, 2 * count + 8);; want = std::min(N6, 2 * want)) {
+    all = modes_of(sub, qb, VecX(), want, 2 * want > N6 ? N6 : 600, {});
+    pick.clear();
+    for (int i = 0; i < want && static_cast<int>(pick.size()) <= count; ++i)
+      if (all.kind[i] != ModeKind::Axial) pick.push_back(i);
+    if (static_cast<int>(pick.size()) > count || want == N6) break;
+  }
+  if (static_cast<int>(pick.size()) < count)
+    throw std::invalid_argument("link " + L.name + ": modes = " + std::to_string(count) + ": it has only " +
+                                std::to_string(pick.size()) + " modes that are not axial");
+  if (static_cast<int>(pick.size()) > count &&
+      std::abs(all.omega[pick[count]] - all.omega[pick[count - 1]]) <= 1e-6 * all.omega[pick[count]])
+    throw std::invalid_argument("link " + L.name + ": modes = " + std::to_string(count) + " keeps one of two equal frequencies (" +
+                                std::to_string(all.omega[pick[count]] / (2 * M_PI)) + " Hz): keep " +
+                                std::to_string(count - 1) + " or " + std::to_string(count + 1) + " modes");
+  const std::vector<int> held(sub.m(), -1);
+  const BorderedPattern pattern(sub, held);
+  MatrixTerms mt;
+  mt.mass = 1.0;
+  std::vector<double> Mv;
+  assemble_matrix(sub, pattern, held, all.q0, VecX::Zero(sub.dof()), mt, Mv);
+  // The shapes over the coordinates a reduced link's modes span (its x1 stay unknowns of their own)
+  // and M_bb Φ_b over them: the x1 rows of M Φ left out, which is M_bb Φ_b + M_b1 Φ_1.
+  LinkModes out;
+  out.omega.resize(count);
+  out.shapes.resize(N, count);
+  out.mass_shapes.resize(N, count);
+  for (int c = 0; c < count; ++c) {
+    out.omega[c] = all.omega[pick[c]];
+    VecX phi = all.shapes.col(pick[c]), Mphi;
+    for (int k = 0; k < n; ++k) phi[sub.rfe_index(l, k)] = 0.0;  // x1 rows out: M_bb Φ_b below
+    pattern.multiply(Mv, phi, Mphi);
+    for (int k = 0; k < n; ++k) {
+      const int at = sub.rfe_index(l, k);
+      out.shapes.col(c).segment<kModalAxes>(kModalAxes * k) = phi.segment<kModalAxes>(at + 1);
+      out.mass_shapes.col(c).segment<kModalAxes>(kModalAxes * k) = Mphi.segment<kModalAxes>(at + 1);
+    }
+  }
+  out.q0 = VecX::Zero(N6);
+  for (int k = 0; k < n; ++k) out.q0.segment<6>(6 * k) = all.q0.segment<6>(sub.rfe_index(l, k));
+  return out;
+}
+
+namespace {
+ModesResult modes_of(const Model& model, const VecX& qb, const VecX& vb, int count, int dense_limit,
+                     const std::vector<int>& free) {
+  const int n = model.n(), nf = static_cast<int>(free.size()), N = model.flexible_dofs() + nf;
   if (std::set<int>(free.begin(), free.end()).size() != free.size())
     throw std::invalid_argument("a joint is freed twice");
   for (int j : free)
@@ -227,12 +320,8 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
   const auto shared_pattern = std::make_shared<const BorderedPattern>(model, cols);
   const BorderedPattern& pattern = *shared_pattern;
   const bool bordered = pattern.n_base() > 0;  // M is then not block diagonal
-  MatrixTerms terms;
-  terms.stiffness = 1.0;
-  terms.gravity = true;
-  terms.inertial = vb.size() > 0 && vb.norm() > 0.0;
   std::vector<double> K, Mv;
-  assemble_matrix(model, pattern, cols, res.q0, v, terms, K);
+  assemble_matrix(model, pattern, cols, res.q0, v, stiffness_terms(vb), K);
   const BlockMass bm = block_mass(model, res.q0);
   if (bordered) {
     MatrixTerms mt;
@@ -307,5 +396,56 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
   }
   return res;
 }
+
+// The reduced model's modes: (Pᵀ K P, Pᵀ M P), dense (its size is the modes kept and the links kept
+// whole), shapes lifted to every rfe coordinate.
+ModesResult reduced_modes(const Model& model, const Reduction& red, const VecX& qb, const VecX& vb, int count,
+                          const std::vector<int>& free) {
+  const int nf = static_cast<int>(free.size()), N = red.rfe() + nf;
+  if (std::set<int>(free.begin(), free.end()).size() != free.size()) throw std::invalid_argument("a joint is freed twice");
+  for (int j : free)
+    if (j < 0 || j >= model.m())
+      throw std::invalid_argument("no joint " + std::to_string(j + 1) + " to free (the model has " + std::to_string(model.m()) + ")");
+  if (count < 1 || count > N)
+    throw std::invalid_argument("mode count must be between 1 and the reduced model's " + std::to_string(N) +
+                                " coordinates (kept modes, the rfe coordinates of links kept whole, free joints)");
+  if (N > 3000) throw std::invalid_argument("modal analysis of a partly reduced model is dense: reduce the long links");
+  ModesResult res;
+  StaticOptions so;
+  so.reduction = &red;
+  res.q0 = solve_static(model, qb, vb, TipLoads{}, so).q;
+  VecX v = VecX::Zero(model.dof());
+  if (vb.size()) model.joint_coords(v) = vb;
+  std::vector<int> cols(model.m(), -1);
+  for (int i = 0; i < nf; ++i) cols[free[i]] = model.flexible_dofs() + i;
+  const BorderedPattern pattern(model, cols);
+  std::vector<double> K, Mv;
+  assemble_matrix(model, pattern, cols, res.q0, v, stiffness_terms(vb), K);
+  MatrixTerms mt;
+  mt.mass = 1.0;
+  assemble_matrix(model, pattern, cols, res.q0, v, mt, Mv);
+  const MatX Kr = MatX(red.reduce(pattern, K)), Mr = MatX(red.reduce(pattern, Mv));
+  Eigen::GeneralizedSelfAdjointEigenSolver<MatX> es(Kr, Mr);
+  if (es.info() != Eigen::Success) throw std::runtime_error("modal analysis: dense eigen-solver failed");
+  const VecX lambda = es.eigenvalues().head(count);
+  res.shapes.resize(model.flexible_dofs() + nf, count);
+  for (int c = 0; c < count; ++c) {
+    const VecX x = es.eigenvectors().col(c);
+    red.lift(x.data(), res.shapes.col(c).data(), nf, false);
+  }
+  res.uncertainty = VecX::Zero(count);
+  const BlockMass bm = block_mass(model, res.q0);
+  double stiffest = 0.0;
+  for (int i = 0; i < N; ++i) stiffest = std::max(stiffest, Kr(i, i) / Mr(i, i));
+  separate_degenerate(lambda, res.shapes, res.uncertainty, bm);
+  res.omega = lambda.cwiseMax(0.0).cwiseSqrt();
+  for (int i = 0; i < count; ++i) {
+    const bool rigid = nf > 0 && std::abs(lambda[i]) <= kRigidModeFraction * stiffest;
+    if (rigid) res.omega[i] = 0.0;
+    res.kind.push_back(rigid ? ModeKind::Rigid : classify(res.shapes.col(i), bm));
+  }
+  return res;
+}
+}  // namespace
 
 }  // namespace rfem

@@ -36,6 +36,22 @@ constexpr double kUncertaintyTolerance = 1e-8;
 ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, int count,
                           int dense_limit = 600, const std::vector<int>& free = {});
 
+/// Coordinates of an rfe a reduced link's modes span: x2, x3, φ1, φ2, φ3 (its axial x1 stays an
+/// unknown of its own: solvers/reduction.hpp says why).
+constexpr int kModalAxes = 5;
+
+/// The first `count` modes of link l clamped in its {r}: every joint held at qb, every other link
+/// rigid (its mass carried where it sits), about the link's static equilibrium there; their rows
+/// over the kModalAxes axes. What a reduced link keeps (solvers/reduction.hpp). Throws
+/// std::invalid_argument for count outside 1 … 5n or a count that cuts a pair of equal frequencies.
+struct LinkModes {
+  VecX omega;        ///< [rad/s], ascending
+  MatX shapes;       ///< 5n × count over kModalAxes axes per rfe, rfe by rfe (x1 rows left out)
+  MatX mass_shapes;  ///< M_bb shapes (M_bb the link's mass matrix over those coordinates)
+  VecX q0;           ///< the equilibrium, 6n, rfe by rfe
+};
+LinkModes link_modes(const Model& model, int l, const VecX& qb, int count);
+
 /// A mode is rigid when ω² is below this fraction of the stiffest coordinate's K_ii / M_ii (the
 /// round-off level of a zero eigenvalue).
 constexpr double kRigidModeFraction = 1e-12;

@@ -3,16 +3,25 @@
 
 #include <stdexcept>
 
+#include "rfem/solvers/mass_solve.hpp"
+
 namespace rfem {
 
 NewtonSystem::NewtonSystem(std::shared_ptr<const Model> model, std::vector<int> base_col, LinearSolverKind kind,
-                           bool keep_stiffness)
+                           bool keep_stiffness, std::shared_ptr<const Reduction> reduction)
     : model_(model ? std::move(model) : throw std::invalid_argument("NewtonSystem: no model")),
       base_col_(std::move(base_col)),
       pattern_(std::make_shared<const BorderedPattern>(*model_, base_col_)),
-      solver_(make_linear_solver(kind, pattern_)),
+      solver_(reduction ? nullptr : make_linear_solver(kind, pattern_)),
       damped_(model_->sdes_damped()),
-      keep_stiffness_(keep_stiffness) {}
+      keep_stiffness_(keep_stiffness),
+      reduction_(std::move(reduction)) {
+  if (reduction_) {
+    P_ = reduction_->projector(pattern_->size() - model_->flexible_dofs());
+    reduced_ = std::make_unique<ReducedFactor>();
+    projection_ = std::make_unique<Projection>(*reduction_, *pattern_);
+  }
+}
 
 bool NewtonSystem::setup(const VecX& q, const VecX& v, double h, Workspace& ws) {
   MatrixTerms terms;
@@ -30,8 +39,26 @@ bool NewtonSystem::setup(const VecX& q, const VecX& v, double h, Workspace& ws) 
     if (keep_stiffness_) K_[d] += kp_[c];
   }
   h_ = h;
+  if (reduction_) {
+    if (keep_stiffness_) Kr_ = projection_->reduce(K_);
+    if (damped_) Cr_ = projection_->reduce(C_);
+    base_rows_ = base_rows_ * P_;
+    return reduced_->factorize(projection_->reduce(S_));
+  }
   solver_->set_threads(ws.parallel.team(model_->n()));
   return solver_->factorize(S_);
+}
+
+bool NewtonSystem::solve_mass(const VecX& q, const VecX& v, VecX& b, std::vector<double>& values, Workspace& ws) const {
+  RFEM_CHECK_ARGUMENT_SIZE(b.size(), size(), "b");
+  if (!reduction_) return rfem::solve_mass(*model_, *pattern_, base_col_, q, v, b, values, &ws);
+  MatrixTerms mt;
+  mt.mass = 1.0;
+  assemble_matrices(*model_, *pattern_, base_col_, q, v, mt, values, {}, nullptr, &ws);
+  ReducedFactor f;
+  if (!f.factorize(projection_->reduce(values))) return false;
+  f.solve(b);
+  return true;
 }
 
 void NewtonSystem::set_joint_feedback(std::vector<double> kp, std::vector<double> kd) {
@@ -44,6 +71,10 @@ void NewtonSystem::set_joint_feedback(std::vector<double> kp, std::vector<double
 }
 
 void NewtonSystem::solve(VecX& b, int threads) const {
+  if (reduced_) {
+    reduced_->solve(b);
+    return;
+  }
   solver_->set_threads(threads);
   solver_->solve(b);
 }
@@ -53,7 +84,8 @@ void NewtonSystem::damping_times(const VecX& x, VecX& y) const {
     y.setZero(x.size());
     return;
   }
-  pattern_->multiply(C_, x, y);
+  if (reduction_) y = Cr_ * x;
+  else pattern_->multiply(C_, x, y);
 }
 
 void NewtonSystem::solve_bdf(const double* b, double* x, int threads) const {
@@ -62,7 +94,8 @@ void NewtonSystem::solve_bdf(const double* b, double* x, int threads) const {
   const int u = size();
   const double c = 1.0 / h_;
   VecX Kb1;
-  pattern_->multiply(K_, Eigen::Map<const VecX>(b, u), Kb1);
+  if (reduction_) Kb1 = Kr_ * Eigen::Map<const VecX>(b, u);
+  else pattern_->multiply(K_, Eigen::Map<const VecX>(b, u), Kb1);
   VecX rhs = c * Eigen::Map<const VecX>(b + u, u) - Kb1;
   solve(rhs, threads);  // S(h) = h² (c² M + c C + K): x2 = S⁻¹ rhs / c²
   rhs *= h_ * h_;

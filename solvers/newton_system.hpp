@@ -9,12 +9,17 @@
 // through its Schur complement: (c² M + c C + K) x2 = c b2 − K b1, x1 = (b1 + x2)/c; K is then
 // kept as well.
 //
+// With reduced links (solvers/reduction.hpp) S is assembled over every coordinate as above and
+// projected, S_r = Pᵀ S P (small: the kept modes), and factorised by a sparse Cholesky; every
+// vector of the methods below is then over the reduced unknowns.
+//
 // The system shares its model and owns its pattern, solver and values; the caller's workspace
 // (thread policy and scratch) is an argument of setup(). Movable, not copyable.
 #include <memory>
 
 #include "rfem/assembly/assemble.hpp"
 #include "rfem/solvers/linear_solver.hpp"
+#include "rfem/solvers/reduction.hpp"
 
 namespace rfem {
 
@@ -24,7 +29,8 @@ class NewtonSystem {
   /// if prescribed. `keep_stiffness`: keep K (IDA's solve). Throws std::invalid_argument for a
   /// null model or a base_col that does not fit it.
   NewtonSystem(std::shared_ptr<const Model> model, std::vector<int> base_col,
-               LinearSolverKind kind = LinearSolverKind::Chain, bool keep_stiffness = false);
+               LinearSolverKind kind = LinearSolverKind::Chain, bool keep_stiffness = false,
+               std::shared_ptr<const Reduction> reduction = nullptr);
   NewtonSystem(NewtonSystem&&) noexcept = default;
   NewtonSystem& operator=(NewtonSystem&&) noexcept = default;
   NewtonSystem(const NewtonSystem&) = delete;
@@ -41,8 +47,12 @@ class NewtonSystem {
   /// IDA's system for x = [x1; x2] (2·size()) given b, with c = 1/h of the last setup.
   void solve_bdf(const double* b, double* x, int threads = 1) const;
   double h() const { return h_; }
-  int size() const { return pattern_->size(); }
+  /// Unknowns: the pattern's, or the reduced ones.
+  int size() const { return reduction_ ? static_cast<int>(P_.cols()) : pattern_->size(); }
   const BorderedPattern& pattern() const { return *pattern_; }
+  /// Solves M b' = b in place with the mass matrix at (q, v) (full coordinates); `values` is scratch.
+  /// False if M is not positive definite.
+  bool solve_mass(const VecX& q, const VecX& v, VecX& b, std::vector<double>& values, Workspace& ws) const;
   /// Rows of every joint of M over the unknowns (m × size()), at the last setup.
   const MatX& base_rows() const { return base_rows_; }
   /// y = C x with the sde damping of the last setup (zero if undamped).
@@ -55,6 +65,10 @@ class NewtonSystem {
   std::unique_ptr<LinearSolver> solver_;
   std::vector<double> S_, K_, C_, kp_, kd_;
   MatX base_rows_;
+  std::shared_ptr<const Reduction> reduction_;
+  SparseMat P_, Kr_, Cr_;  // reduced links: P and the projected K and C
+  std::unique_ptr<Projection> projection_;
+  std::unique_ptr<ReducedFactor> reduced_;
   bool damped_, keep_stiffness_;
   double h_ = 0.0;
 };

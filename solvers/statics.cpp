@@ -10,6 +10,7 @@
 #include "rfem/core/positions.hpp"
 #include "rfem/core/rotation.hpp"
 #include "rfem/solvers/cholmod_solver.hpp"
+#include "rfem/solvers/reduction.hpp"
 
 namespace rfem {
 
@@ -101,23 +102,39 @@ StaticResult solve_static(const Model& model, const VecX& qb, const VecX& vb, co
   const std::vector<int> held(m, -1);
   const auto shared_pattern = std::make_shared<const BorderedPattern>(model, held);
   const BorderedPattern& pattern = *shared_pattern;
+  std::shared_ptr<const Reduction> own;  // reduced links: Newton on η, q = q0 + Φ η
+  const Reduction* red = opts.reduction;
+  if (!red && (own = Reduction::of(model, qb))) red = own.get();
+  const int n6 = model.flexible_dofs(), nu = red ? red->rfe() : n6;
   CholmodSolver solver(shared_pattern);
+  ReducedFactor reduced;
+  std::unique_ptr<Projection> projection;
+  if (red) projection = std::make_unique<Projection>(*red, pattern);
   MatrixTerms terms;
   terms.stiffness = 1.0;
   terms.gravity = true;
   terms.inertial = vb.size() > 0 && vb.norm() > 0.0;
   std::vector<double> values;
   Workspace ws(model, opts.parallel);  // the Newton iteration's scratch, cut once
+  auto project = [&](const VecX& r) {
+    if (!red) return r;
+    VecX p(nu);
+    red->project(r.data(), p.data(), 0);
+    return p;
+  };
 
   // Load scale for the convergence test: the full load vector at the undeformed state.
-  const double scale = std::max(residual(model, res.q, v, loads, 1.0, ws).norm(), 1e-12);
+  const double scale = std::max(project(residual(model, res.q, v, loads, 1.0, ws)).norm(), 1e-12);
+  VecX eta = VecX::Zero(nu);  // the unknowns: every rfe coordinate, or the reduced ones
+  if (red) red->lift(eta.data(), res.q.data(), 0, true);  // η = 0: the equilibrium the modes are taken about
+  else eta = res.q.head(n6);
   double lam = 0.0, step = 1.0;
   while (lam < 1.0) {
     const double target = std::min(1.0, lam + step);
-    VecX q = res.q;
+    VecX q = res.q, x = eta;
     bool ok = false;
     for (int it = 0; it < opts.max_iterations; ++it) {
-      const VecX r = residual(model, q, v, loads, target, ws);
+      const VecX r = project(residual(model, q, v, loads, target, ws));
       res.residual = r.norm();
       if (!std::isfinite(res.residual)) break;
       if (res.residual <= opts.tolerance * scale) {
@@ -125,21 +142,29 @@ StaticResult solve_static(const Model& model, const VecX& qb, const VecX& vb, co
         break;
       }
       assemble_matrix(model, pattern, held, q, v, terms, values, &ws);
-      if (!solver.factorize(values)) break;
       VecX dq = -r;
-      solver.solve(dq);
-      q.head(model.flexible_dofs()) += dq;
+      if (red) {
+        if (!reduced.factorize(projection->reduce(values), false)) break;
+        reduced.solve(dq);
+      } else {
+        if (!solver.factorize(values)) break;
+        solver.solve(dq);
+      }
+      x += dq;
+      if (red) red->lift(x.data(), q.data(), 0, true);
+      else q.head(n6) = x;
       ++res.iterations;
       // Converged when the correction is at round-off of the coordinates (the residual itself
       // cannot drop below round-off of the stiff axial springs, c Δx ~ 1e8 N/m × 1e-15 m).
-      if (dq.lpNorm<Eigen::Infinity>() <= opts.step_tolerance * (1.0 + q.head(model.flexible_dofs()).lpNorm<Eigen::Infinity>())) {
-        res.residual = residual(model, q, v, loads, target, ws).norm();
+      if (dq.lpNorm<Eigen::Infinity>() <= opts.step_tolerance * (1.0 + x.lpNorm<Eigen::Infinity>())) {
+        res.residual = project(residual(model, q, v, loads, target, ws)).norm();
         ok = std::isfinite(res.residual);
         break;
       }
     }
     if (ok) {
       res.q = q;
+      eta = x;
       lam = target;
       ++res.load_steps;
       step *= 2.0;

@@ -17,12 +17,17 @@ struct TipLoads {
   int link = -1;               ///< the link (−1: the last one)
 };
 
+class Reduction;
+
 struct StaticOptions {
   int max_iterations = 50;
   double tolerance = 1e-10;       ///< on the residual, relative to the applied load scale
   double step_tolerance = 1e-13;  ///< on the Newton correction, relative to the coordinates
   int max_load_steps = 64;
   Parallelism parallel;  ///< the residual's team (a run's: its `threads`)
+  /// The model's modal reduction at these joint values, if the caller has it (solvers/reduction.hpp);
+  /// a model with reduced links gets one built otherwise. The equilibrium is then the reduced one.
+  const Reduction* reduction = nullptr;
 };
 
 struct StaticResult {

@@ -288,33 +288,17 @@ std::shared_ptr<const Model> Simulation::shared_model() const { return impl_->mo
 double Simulation::time() const { return impl_->stepper->time(); }
 double Simulation::t_end() const { return impl_->o.t_end; }
 
-namespace {
-// Every coordinate (rates: every rate) from the unknowns and the prescribed joints' laws at t.
-// The full coordinates (order 0), rates (1) or accelerations (2): the unknowns' and the prescribed
-// joints' motion at t.
-VecX full(const Model& model, const EquationsOfMotion& eq, const std::vector<JointInput>& inputs, const VecX& unknowns,
-          double t, int order) {
-  VecX x = VecX::Zero(model.dof());
-  for (int i = 0; i < eq.unknowns(); ++i) x[eq.unknown_index(i)] = unknowns[i];
-  for (int j = 0; j < model.m(); ++j)
-    if (inputs[j].prescribed()) {
-      const MotionSample s = inputs[j].motion->at(t);
-      x[model.joint_index(j)] = order == 0 ? s.q : order == 1 ? s.qd : s.qdd;
-    }
-  return x;
-}
-}  // namespace
 
 VecX Simulation::q() const {
   const Impl& m = *impl_;
   const IntegratorState x = m.stepper->state();
-  return full(*m.model, *m.eq, m.inputs, x.q, x.t, 0);
+  return m.eq->full_coordinates(x.t, x.q.data(), 0);
 }
 
 VecX Simulation::v() const {
   const Impl& m = *impl_;
   const IntegratorState x = m.stepper->state();
-  return full(*m.model, *m.eq, m.inputs, x.v, x.t, 1);
+  return m.eq->full_coordinates(x.t, x.v.data(), 1);
 }
 
 std::vector<std::string> Simulation::coordinate_names() const {
@@ -392,7 +376,7 @@ Snapshot Simulation::snapshot() {
   // motion); a snapshot needs no energies or momentum (an output sample's extra passes).
   m.scratch.resize(m.eq->unknowns());
   m.eq->residual(x.t, x.q.data(), x.v.data(), x.a.data(), m.scratch.data());
-  const VecX q = full(*m.model, *m.eq, m.inputs, x.q, x.t, 0), v = full(*m.model, *m.eq, m.inputs, x.v, x.t, 1);
+  const VecX q = m.eq->full_coordinates(x.t, x.q.data(), 0), v = m.eq->full_coordinates(x.t, x.v.data(), 1);
   Snapshot y;
   y.t = x.t;
   y.joint_q = m.model->joint_coords(q);
@@ -404,7 +388,7 @@ Snapshot Simulation::snapshot() {
   }
   if (m.sensors) {
     std::vector<double> values;
-    m.sensors->read(q, v, full(*m.model, *m.eq, m.inputs, x.a, x.t, 2), y.joint_tau, values, 0);
+    m.sensors->read(q, v, m.eq->full_coordinates(x.t, x.a.data(), 2), y.joint_tau, values, 0);
     size_t k = 0;
     for (size_t i = 0; i < m.sensors->size(); ++i) {
       const auto w = static_cast<size_t>(m.sensors->width(i));
@@ -447,7 +431,7 @@ LinearModel Simulation::linearize(bool equilibrium) {
   lin.t = x.t;
   lin.equilibrium = equilibrium;
   const std::vector<std::string> names = coordinate_names();
-  for (int i = 0; i < N; ++i) lin.states.push_back(names[static_cast<size_t>(eq.unknown_index(i))]);
+  lin.states = eq.unknown_names(names);
   std::vector<int> free_rows;
   for (int j = 0; j < md.m(); ++j)
     if (eq.base_col()[j] >= 0) {
@@ -474,7 +458,7 @@ LinearModel Simulation::linearize(bool equilibrium) {
     r.resize(N);
     eq.residual(x.t, qu.data(), vu.data(), au.data(), r.data());
     const VecX tau = eq.torques(x.t);
-    const VecX q = full(md, eq, m.inputs, qu, x.t, 0), v = full(md, eq, m.inputs, vu, x.t, 1), a = full(md, eq, m.inputs, au, x.t, 2);
+    const VecX q = eq.full_coordinates(x.t, qu.data(), 0), v = eq.full_coordinates(x.t, vu.data(), 1), a = eq.full_coordinates(x.t, au.data(), 2);
     out.clear();
     for (size_t l = 0; l < md.links.size(); ++l) {
       const Vec3 d = tip_deflection(md, static_cast<int>(l), q);
@@ -485,7 +469,7 @@ LinearModel Simulation::linearize(bool equilibrium) {
     y = Eigen::Map<const VecX>(out.data(), static_cast<Eigen::Index>(out.size()));
   };
   const VecX a0 = equilibrium ? VecX::Zero(N) : x.a;
-  linearize_about(f, x.q, x.v, a0, free_rows, 6 * md.n(), lin);
+  linearize_about(f, x.q, x.v, a0, free_rows, N - static_cast<int>(free_rows.size()), lin);
   return lin;
 }
 
