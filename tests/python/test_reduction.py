@@ -90,3 +90,16 @@ def test_a_reduced_links_linear_model_has_the_kept_modes():
     f = np.sqrt(np.sort(sl.eigh(lin.K, lin.M, eigvals_only=True))[:4]) / (2 * np.pi)
     full = np.asarray(rfem.modes(rfem.load(case_path("kane_spinup.toml")), n=12, count=4).frequencies)
     assert np.max(np.abs(f - full) / full) < 1e-8, (f, full)
+
+
+def test_show_counts_a_reduced_links_unknowns():
+    """`rfem show`: the paper's link 3 (n = 6) reduced to 8 modes has its 6 axial coordinates and 8
+    modes unknown (14 of 39 coordinates, the joints prescribed), not 36."""
+    import json
+
+    r = subprocess.run([RFEM, "show", case_path("paper_deployment.toml"), "--set", "link.modes=8", "--json"],
+                       capture_output=True, text=True, check=True)
+    assert json.loads(r.stdout)["unknowns"] == 14
+    r = subprocess.run([RFEM, "show", case_path("paper_deployment.toml"), "--set", "link.modes=8"], capture_output=True,
+                       text=True, check=True)
+    assert "reduced: 8 modes and its 6 axial coordinates" in r.stdout

@@ -1,0 +1,64 @@
+#!/usr/bin/python3
+"""Work and precision of reduced links (README, "Reduced links"; docs/formulation.md §9): the paper's
+procedure (cases/paper_deployment.toml) with link 3 kept whole and reduced to m modes, at one n and
+thread count. Per m and run (kinematic, force): the median wall time over --repeat runs, steps,
+residual evaluations, the ratio of the wall time to the full model's kinematic run (issue 35's goal:
+the reduced force run ≤ 1.5×), and the peaks of u1, u2, θ against the full model's (relative).
+
+  /usr/bin/python3 bench/reduction_bench.py [--n 1000] [--modes 4,8,16] [--threads 2] [--repeat 3]
+      [--set key=value …]
+Threads are pinned with OMP_PROC_BIND=close OMP_PLACES=cores.
+"""
+import argparse, json, os, statistics, subprocess, sys, tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+CASE = os.path.join(HERE, "..", "cases", "paper_deployment.toml")
+
+
+def procedure(rfem, n, threads, m, sets, tmp):
+    """One run of the procedure: {run name: its JSON record}."""
+    env = dict(os.environ, OMP_PROC_BIND="close", OMP_PLACES="cores")
+    cmd = [rfem, "--threads", str(threads), "run", CASE, "--n", str(n), "--json", "-o", os.path.join(tmp, "r.h5")]
+    for x in sets + ([f"link.modes={m}"] if m else []):
+        cmd += ["--set", x]
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    if p.returncode != 0:
+        sys.exit(f"reduction_bench: {' '.join(cmd)} failed: {p.stderr.strip()}")
+    return {r["name"]: r for r in json.loads(p.stdout)["runs"]}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--rfem", default=os.path.join(HERE, "..", "build", "apps", "rfem"))
+    ap.add_argument("--n", type=int, default=1000)
+    ap.add_argument("--modes", default="4,8,16")
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--set", action="append", default=[], help="case override for every run (key.path=value)")
+    a = ap.parse_args()
+    ms = [0] + [int(x) for x in a.modes.split(",")]
+    print(f"machine: {os.cpu_count()} cores, {os.uname().machine}; n = {a.n}, {a.threads} threads, median of {a.repeat} "
+          f"(the configurations interleaved)")
+    walls = {m: {"kinematic": [], "force": []} for m in ms}
+    last = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for _ in range(a.repeat):
+            for m in ms:
+                runs = procedure(a.rfem, a.n, a.threads, m, a.set, tmp)
+                for name in ("kinematic", "force"):
+                    walls[m][name].append(runs[name]["wall_time_s"])
+                last[m] = runs
+    ref = statistics.median(walls[0]["kinematic"])
+    print(f"{'m':>5}{'run':>11}{'wall [s]':>10}{'/kin full':>10}{'steps':>8}{'resid':>8}"
+          f"{'d peak u1':>11}{'d peak u2':>11}{'d peak th':>11}")
+    for m in ms:
+        for name in ("kinematic", "force"):
+            r, f = last[m][name], last[0][name]
+            d = [abs(r[k] - f[k]) / abs(f[k]) for k in ("peak_u1", "peak_u2", "peak_theta")]
+            w = statistics.median(walls[m][name])
+            print(f"{m if m else 'full':>5}{name:>11}{w:>10.2f}{w / ref:>10.2f}{r['steps']:>8}{r['residual_evals']:>8}"
+                  f"{d[0]:>11.1e}{d[1]:>11.1e}{d[2]:>11.1e}")
+
+
+if __name__ == "__main__":
+    main()
