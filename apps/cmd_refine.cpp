@@ -17,7 +17,20 @@ namespace rfem::app {
 
 namespace {
 
+void print_modes_tables(const Case& cs, const RefineResult& res) {
+  for (size_t k = 0; k < res.quantities.size(); ++k) {
+    const Refinement& t = res.tables[k];
+    fmt::print("{} over modes at n = {}: {}\n{:>6} {:>20} {:>14} {:>10}\n", cs.name.empty() ? cs.path : cs.name, res.ns.at(0),
+               res.quantities[k].text, "modes", "value", "to full", "relative");
+    const double full = t.rows.back().value;
+    for (const auto& r : t.rows)
+      fmt::print("{:>6} {:>20.12e} {:>14.3e} {:>10}\n", r.n ? std::to_string(r.n) : std::string("full"), r.value, r.change,
+                 full != 0.0 ? fmt::format("{:.2e}", std::abs(r.change / full)) : std::string("-"));
+  }
+}
+
 void print_tables(const Case& cs, const RefineResult& res) {
+  if (!res.modes.empty()) return print_modes_tables(cs, res);
   auto opt = [](double x, const char* f) { return std::isfinite(x) ? fmt::format(fmt::runtime(f), x) : std::string("-"); };
   for (size_t k = 0; k < res.quantities.size(); ++k) {
     const Refinement& t = res.tables[k];
@@ -38,6 +51,7 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
   const Case cs = read_checked_case(c);
   RefineRequest rq;
   rq.ns = ro.ns;
+  rq.modes = ro.modes;
   rq.quantities = ro.quantities;
   rq.integration_check = ro.integration_check;
   rq.rate = o.rate;
@@ -55,14 +69,15 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
     }
   }
   const bool quiet = c.json || c.quiet;
-  if (dynamic) check_run_cost(cs, model_of(cs, ro.ns.back()), joint_inputs(cs), c);
+  if (dynamic) check_run_cost(cs, model_of(cs, ro.ns.back()), joint_inputs(cs), c);  // (the full model: the dearest)
   const SignalStop signals(rq.stop);
   ProgressLine progress(quiet);
   rq.progress = [&](const Progress& p) { progress.show(p); };
   rq.on_n = [&](int i, int count, int n) {
     progress.clear();
     if (quiet) return;
-    if (i < count) fmt::print(stderr, "[{}/{}] n = {}\n", i + 1, count, n);
+    if (!rq.modes.empty()) fmt::print(stderr, "[{}/{}] {}\n", i + 1, count, n ? fmt::format("modes = {}", n) : std::string("full model"));
+    else if (i < count) fmt::print(stderr, "[{}/{}] n = {}\n", i + 1, count, n);
     else fmt::print(stderr, "[check] n = {} at rtol {:g}\n", n, cs.sim.options.rtol / 100);
   };
   const RefineResult res = path.empty() ? refine(cs, rq) : refine_into_file(cs, rq, path, c.command_line);
@@ -78,6 +93,13 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
       for (const auto& r : res.tables[k].rows)
         rows.push_back({{"n", r.n}, {"value", r.value}, {"change", num(r.change)}, {"order", num(r.order)},
                         {"richardson", num(r.richardson)}});
+      if (!res.modes.empty())
+        for (size_t i = 0; i < rows.size(); ++i) {
+          rows[i].erase("n");
+          rows[i].erase("order");
+          rows[i].erase("richardson");
+          rows[i]["modes"] = res.modes[i];
+        }
       jq.push_back({{"quantity", qs[k].text}, {"rows", rows}, {"fitted_order", num(res.tables[k].fitted_order)},
                     {"integration_error", num(res.tables[k].integration_error)}, {"warnings", res.tables[k].warnings}});
     }

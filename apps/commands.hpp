@@ -42,6 +42,7 @@ struct RefineOptions {
   std::vector<std::string> quantities;  ///< evaluated from the same runs
   std::string output;                   ///< HDF5 file (default for dynamic quantities: CASE_refine.h5)
   bool integration_check = true;        ///< rerun the finest n at 100× tighter tolerances
+  std::vector<int> modes;               ///< a series over link.modes at one n, against the full model
 };
 
 /// `rfem show`: the assembled tree of joints, links and bodies.

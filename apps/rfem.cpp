@@ -152,6 +152,10 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->required();
   rf->add_option("-o,--output", ro.output, "HDF5 file for every run and the tables (default for dynamic quantities: CASE_refine.h5)");
+  rf->add_option("--modes", ro.modes,
+                 "a series over modes instead of n: every flexible link reduced to m modes (link.modes), increasing, "
+                 "at the one --n, each against the full model: --modes 4,8,16")
+      ->delimiter(',');
   bool no_check = false;
   rf->add_flag("--no-integration-check", no_check,
                "do not rerun the finest n at 100x tighter tolerances to estimate the integration error");

@@ -30,7 +30,8 @@ NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?|[-+]?\b(?:nan
 RTOL, ATOL = 1e-5, 1e-12
 PYTHON = ["ex1_paper_figures", "ex2_refinement", "ex3_parameter_study", "ex4_modes_rotation", "ex5_two_link_pd",
           "ex7_urdf_arm", "ex8_control_loop", "ex9_input_shaping", "ex10_strain_feedback",
-          "ex11_urdf_strain_feedback", "ex13_lqr"]
+          "ex11_urdf_strain_feedback", "ex13_lqr", "ex14_kane_hub_linear",
+          "ex15_reduced_force"]
 CPP = ["ex6_library", "ex12_controller"]
 NOTEBOOKS = ["notebook"]
 

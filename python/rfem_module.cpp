@@ -520,7 +520,8 @@ PYBIND11_MODULE(_rfem, m) {
   }, py::arg("case"), py::arg("n"), py::arg("count"), py::arg("free"), py::arg("rate"), py::arg("joint"), py::arg("output"));
 
   m.def("_refine", [](py::handle case_arg, py::handle ns, py::handle quantity_args, py::handle output_arg,
-                      py::handle integration_check, py::handle rate, py::handle joint, py::handle threads, py::handle progress) {
+                      py::handle integration_check, py::handle rate, py::handle joint, py::handle threads, py::handle progress,
+                      py::handle modes) {
     const args::CaseArg cs_arg(case_arg);
     const Case& cs = *cs_arg;
     const std::vector<std::string> quantities = args::texts(quantity_args, "quantities");
@@ -529,6 +530,7 @@ PYBIND11_MODULE(_rfem, m) {
     pending->progress = args::callback(progress, "progress");
     RefineRequest rq;
     rq.ns = args::rfes_list(ns, "ns");
+    if (!modes.is_none()) rq.modes = args::rfes_list(modes, "modes");
     rq.quantities = quantities;
     rq.integration_check = args::flag(integration_check, "integration_check");
     rq.rate = joint_rate(rate, joint);
@@ -547,6 +549,7 @@ PYBIND11_MODULE(_rfem, m) {
     py::dict out;
     out["status"] = res.status.to_string();
     out["ns"] = res.ns;
+    out["modes"] = res.modes;
     py::list tables;
     for (size_t k = 0; k < res.tables.size(); ++k) {
       const Refinement& t = res.tables[k];
@@ -554,7 +557,7 @@ PYBIND11_MODULE(_rfem, m) {
       for (const auto& r : t.rows) n.push_back(r.n);
       py::dict d;
       d["quantity"] = res.quantities[k].text;
-      d["n"] = py::array(py::cast(n));
+      d[res.modes.empty() ? "n" : "modes"] = py::array(py::cast(n));
       for (auto [name, field] : {std::pair{"value", &RefinementRow::value}, {"change", &RefinementRow::change},
                                  {"order", &RefinementRow::order}, {"richardson", &RefinementRow::richardson}})
         d[name] = py::array(py::cast(t.column(field)));
@@ -570,7 +573,7 @@ PYBIND11_MODULE(_rfem, m) {
     pending->progress = py::none();
     return py::make_tuple(out, error);
   }, py::arg("case"), py::arg("ns"), py::arg("quantities"), py::arg("output"), py::arg("integration_check"),
-     py::arg("rate"), py::arg("joint"), py::arg("threads"), py::arg("progress"));
+     py::arg("rate"), py::arg("joint"), py::arg("threads"), py::arg("progress"), py::arg("modes"));
   bind_sweep(m);
   bind_simulation(m);
 }

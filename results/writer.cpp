@@ -145,15 +145,16 @@ void put_vector(hid_t g, const char* name, const std::vector<double>& v, const s
 }  // namespace
 
 void ResultsWriter::write_refinement(const std::vector<std::string>& quantities, const std::vector<int>& ns,
-                                     const std::vector<Refinement>& tables, const RunStatus& status) {
+                                     const std::vector<Refinement>& tables, const RunStatus& status, int modes_at_n) {
   const h5::Quiet quiet;
   File& f = *file_;
   f.end_swmr();
   const std::string what = f.what("writing the refinement tables");
   if (H5Lexists(f.id, "refine", H5P_DEFAULT) > 0) h5::check(H5Ldelete(f.id, "refine", H5P_DEFAULT), what);
   const h5::Handle g = h5::group(H5Gcreate2(f.id, "refine", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), what);
-  put_vector(g, "n", std::vector<double>(ns.begin(), ns.end()), what);
+  put_vector(g, modes_at_n > 0 ? "modes" : "n", std::vector<double>(ns.begin(), ns.end()), what);
   h5::write_attribute(g, "status", status.to_string());
+  if (modes_at_n > 0) h5::write_attribute(g, "n", static_cast<long>(modes_at_n));
   h5::write_attribute(g, "quantities", static_cast<long>(quantities.size()));
   for (size_t k = 0; k < quantities.size(); ++k) {
     const Refinement& t = tables[k];

@@ -70,9 +70,10 @@ class ResultsWriter {
   std::unique_ptr<RunWriter> resume_run(const std::string& name, std::shared_ptr<const Model> model,
                                         const RunDescription& description, const Checkpoint& from);
   /// The group `refine`: n and, per quantity, refine/q<k> with value, change, order, richardson
-  /// and its assessment; the first quantity's datasets also directly in `refine`.
+  /// and its assessment; the first quantity's datasets also directly in `refine`. A series over
+  /// modes (`modes_at_n` > 0, its n an attribute) has a dataset `modes` (0: the full model) for n.
   void write_refinement(const std::vector<std::string>& quantities, const std::vector<int>& ns,
-                        const std::vector<Refinement>& tables, const RunStatus& status);
+                        const std::vector<Refinement>& tables, const RunStatus& status, int modes_at_n = 0);
   /// A table that does not grow (rows × columns, row-major), with its columns, units and
   /// description; its groups are created as needed ("modes/shapes").
   void write_table(const std::string& name, const Table& table, const std::vector<std::string>& columns,

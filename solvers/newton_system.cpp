@@ -13,9 +13,9 @@ NewtonSystem::NewtonSystem(std::shared_ptr<const Model> model, std::vector<int> 
       base_col_(std::move(base_col)),
       pattern_(std::make_shared<const BorderedPattern>(*model_, base_col_)),
       solver_(reduction ? nullptr : make_linear_solver(kind, pattern_)),
+      reduction_(std::move(reduction)),
       damped_(model_->sdes_damped()),
-      keep_stiffness_(keep_stiffness),
-      reduction_(std::move(reduction)) {
+      keep_stiffness_(keep_stiffness) {
   if (reduction_) {
     P_ = reduction_->projector(pattern_->size() - model_->flexible_dofs());
     reduced_ = std::make_unique<ReducedFactor>();

@@ -91,10 +91,11 @@ void Reduction::restrict(const double* xf, double* x, int k, bool positions) con
 }
 
 SparseMat Reduction::reduce(const BorderedPattern& pattern, const std::vector<double>& values) const {
-  return Projection(*this, pattern).reduce(values);
+  Projection p(*this, pattern);
+  return p.reduce(values);  // (a copy: p's matrix goes with it)
 }
 
-Projection::Projection(const Reduction& red, const BorderedPattern& pattern) {
+Projection::Projection(const Reduction& red, const BorderedPattern& pattern) : red_(&red) {
   const BorderedPattern::Csc& csc = pattern.csc();
   const int n = pattern.size();
   std::vector<Eigen::Triplet<double>> t;  // value: the slot, to find each entry's slot below
@@ -109,15 +110,94 @@ Projection::Projection(const Reduction& red, const BorderedPattern& pattern) {
   S_.setFromTriplets(t.begin(), t.end());  // (no duplicates: each entry once per triangle)
   slot_.resize(static_cast<size_t>(S_.nonZeros()));
   for (long k = 0; k < S_.nonZeros(); ++k) slot_[static_cast<size_t>(k)] = static_cast<long>(S_.valuePtr()[k]);
-  P_ = red.projector(n - red.full_rfe());
-  Pt_ = P_.transpose();
+
+  // Full coordinate → reduced: kept ones (rfe coordinates kept, joints) to their reduced index,
+  // a reduced link's lateral ones to (link, row of Φ_l).
+  const int joints = n - red.full_rfe();
+  const auto& links = red.links();
+  const int L = static_cast<int>(links.size());
+  std::vector<int> to(n, -1);
+  link_of_.assign(n, -1);
+  for (int l = 0; l < L; ++l)
+    for (size_t e = 0; e < links[l].rfe.size(); ++e)
+      for (int ax = 0; ax < kModalAxes; ++ax) link_of_[links[l].rfe[e] + 1 + ax] = l;
+  for (int i = 0, k = 0; i < red.full_rfe(); ++i)
+    if (link_of_[i] < 0) to[i] = k++;
+  for (int j = 0; j < joints; ++j) to[red.full_rfe() + j] = red.rfe() + j;
+
+  // The reduced pattern: kept × kept where S has an entry; kept × η_l (dense) where the kept row
+  // touches link l's lateral rows; η_l × η_l' (dense) where the links' lateral rows touch.
+  const int nr = red.rfe() + joints;
+  std::vector<char> pair(static_cast<size_t>(L * L), 0);
+  std::vector<Eigen::Triplet<double>> rt;
+  std::vector<Source> src;
+  auto add = [&](int r, int c, Source s) {
+    rt.emplace_back(r, c, static_cast<double>(src.size()));
+    src.push_back(s);
+  };
+  std::vector<char> kept_link(static_cast<size_t>(n) * L, 0);
+  for (int c = 0; c < n; ++c)
+    for (SparseMat::InnerIterator it(S_, c); it; ++it) {
+      const int r = static_cast<int>(it.row());
+      if (to[r] >= 0 && to[c] >= 0) {
+        add(to[r], to[c], Source{0, static_cast<int>(&it.value() - S_.valuePtr()), 0, 0, 0});
+      } else if (to[r] >= 0 && link_of_[c] >= 0) {
+        kept_link[static_cast<size_t>(r) * L + link_of_[c]] = 1;
+      } else if (link_of_[r] >= 0 && link_of_[c] >= 0) {
+        pair[static_cast<size_t>(link_of_[r] * L + link_of_[c])] = 1;
+      }
+    }
+  for (int r = 0; r < n; ++r)
+    for (int l = 0; l < L; ++l)
+      if (to[r] >= 0 && kept_link[static_cast<size_t>(r) * L + l])
+        for (int c = 0; c < links[l].phi.cols(); ++c) {
+          add(to[r], links[l].first + c, Source{1, r, 0, l, c});
+          add(links[l].first + c, to[r], Source{1, r, 0, l, c});
+        }
+  for (int l = 0; l < L; ++l)
+    for (int l2 = 0; l2 < L; ++l2)
+      if (pair[static_cast<size_t>(l * L + l2)])
+        for (int a = 0; a < links[l].phi.cols(); ++a)
+          for (int c = 0; c < links[l2].phi.cols(); ++c) add(links[l].first + a, links[l2].first + c, Source{2, a, l, l2, c});
+  R_.resize(nr, nr);
+  R_.setFromTriplets(rt.begin(), rt.end());  // (each entry once)
+  source_.resize(static_cast<size_t>(R_.nonZeros()));
+  for (long k = 0; k < R_.nonZeros(); ++k) source_[static_cast<size_t>(k)] = src[static_cast<size_t>(R_.valuePtr()[k])];
+  W_.resize(static_cast<size_t>(L));
+  G_.resize(static_cast<size_t>(L * L));
 }
 
-SparseMat Projection::reduce(const std::vector<double>& values) {
+const SparseMat& Projection::reduce(const std::vector<double>& values) {
   double* v = S_.valuePtr();
   for (size_t k = 0; k < slot_.size(); ++k) v[k] = values[static_cast<size_t>(slot_[k])];
-  const SparseMat SP = S_ * P_;
-  return SparseMat(Pt_ * SP);
+  const auto& links = red_->links();
+  const int L = static_cast<int>(links.size());
+  for (int l = 0; l < L; ++l) {  // W_l = S Φ_l: over link l's lateral columns of S
+    const MatX& phi = links[l].phi;
+    RowMat& W = W_[static_cast<size_t>(l)];
+    W.setZero(S_.rows(), phi.cols());
+    for (size_t e = 0; e < links[l].rfe.size(); ++e)
+      for (int ax = 0; ax < kModalAxes; ++ax) {
+        const int col = links[l].rfe[e] + 1 + ax;
+        const auto row = phi.row(kModalAxes * static_cast<int>(e) + ax);
+        for (SparseMat::InnerIterator it(S_, col); it; ++it) W.row(it.row()) += it.value() * row;
+      }
+  }
+  for (int l = 0; l < L; ++l) {  // the lateral rows of each link, then Φ_lᵀ W_l'
+    for (int l2 = 0; l2 < L; ++l2) {
+      const RowMat& W = W_[static_cast<size_t>(l2)];
+      wb_.resize(links[l].phi.rows(), W.cols());
+      for (size_t e = 0; e < links[l].rfe.size(); ++e)
+        wb_.middleRows<kModalAxes>(kModalAxes * static_cast<int>(e)) = W.middleRows<kModalAxes>(links[l].rfe[e] + 1);
+      G_[static_cast<size_t>(l * L + l2)].noalias() = links[l].phi.transpose() * wb_;
+    }
+  }
+  double* out = R_.valuePtr();
+  for (size_t k = 0; k < source_.size(); ++k) {
+    const Source& s = source_[k];
+    out[k] = s.kind == 0 ? v[s.a] : s.kind == 1 ? W_[static_cast<size_t>(s.l)](s.a, s.c) : G_[static_cast<size_t>(s.b * L + s.l)](s.a, s.c);
+  }
+  return R_;
 }
 
 std::vector<std::string> Reduction::names(const Model& model, const std::vector<std::string>& full_names) const {

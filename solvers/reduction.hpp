@@ -71,17 +71,32 @@ class Reduction {
   std::vector<Link> links_;
 };
 
-/// Pᵀ S P for matrices S on one pattern, again and again: S's compressed columns (both
-/// triangles) are laid out once and only their values gathered from the pattern's slots.
+/// Pᵀ S P for matrices S on one pattern, again and again. Its layout is fixed once: S's compressed
+/// columns (both triangles) with each value's slot in the pattern, and the reduced matrix's pattern
+/// with the source of each entry. Each call then gathers S's values, forms W_l = S Φ_l (S sparse,
+/// Φ_l dense over link l's lateral rows: nnz · m) and reads every reduced entry off S (kept × kept),
+/// W_l (kept × η_l) or Φ_lᵀ W_l' (η_l × η_l'), in place — a generic sparse product with Φ's dense
+/// columns cost 3× more per step (docs/performance.md, "Reduced links").
 class Projection {
  public:
   Projection(const Reduction& reduction, const BorderedPattern& pattern);
-  /// Pᵀ S P for the upper triangle `values` (pattern.nnz()).
-  SparseMat reduce(const std::vector<double>& values);
+  /// Pᵀ S P for the upper triangle `values` (pattern.nnz()); valid until the next call.
+  const SparseMat& reduce(const std::vector<double>& values);
 
  private:
-  SparseMat S_, P_, Pt_;
-  std::vector<long> slot_;  // S_'s value k is values[slot_[k]]
+  struct Source {         // where a reduced entry's value comes from
+    int kind = 0;         // 0: S's value `a`; 1: W_l(row a, col c); 2: (Φ_lᵀ W_l')(row a, col c) with l = b
+    int a = 0, b = 0, l = 0, c = 0;
+  };
+  const Reduction* red_ = nullptr;
+  SparseMat S_, R_;
+  std::vector<long> slot_;      // S_'s value k is values[slot_[k]]
+  std::vector<Source> source_;  // R_'s value k
+  using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  std::vector<int> link_of_;    // per full coordinate: its reduced link (−1: kept)
+  std::vector<RowMat> W_;       // S Φ_l over every full row (rows: S's columns are added row-wise)
+  RowMat wb_;                   // W_l' at link l's lateral rows
+  std::vector<MatX> G_;         // Φ_lᵀ W_l' per link pair (l·links + l')
 };
 
 /// LDLᵀ factor of a reduced (sparse, symmetric) matrix, its ordering analysed once per pattern.

@@ -39,10 +39,86 @@ std::vector<double> evaluate_dynamic(const Case& cs, const std::vector<JointInpu
   return values.values();
 }
 
+// Every quantity at one point of the series (a run of the procedure for the dynamic ones), appended
+// to `values`; false (the status interrupted) if the study was stopped. `label` names the point in
+// messages ("n = 24", "modes = 8").
+bool evaluate_point(const Case& c, int n, const std::vector<JointInput>& inputs, const std::string& prefix,
+                    const std::string& label, const RefineRequest& rq, RefineResult& res,
+                    std::vector<std::vector<double>>& values) {
+  const std::vector<Quantity>& qs = res.quantities;
+  std::vector<double> dyn;
+  if (res.dynamic) dyn = evaluate_dynamic(c, inputs, n, qs, prefix, rq);
+  if (rq.stop.requested()) {
+    res.status = RunStatus::interrupted(rq.stop.signal());
+    return false;
+  }
+  for (size_t k = 0; k < qs.size(); ++k) {
+    values[k].push_back(qs[k].dynamic() ? dyn[k] : evaluate_quantity(c, n, qs[k], rq.rate));
+    if (!std::isfinite(values[k].back()))
+      throw std::runtime_error(label + ": " + qs[k].text + " is not finite: check the case's values");
+  }
+  return true;
+}
+
+// The case with every flexible link at n reduced to m modes (0: every rfe coordinate).
+Case with_modes(const Case& cs, int n, int m) {
+  Case c = cs;
+  const Model model = build_model(cs, n);
+  for (size_t l = 0; l < c.links.size() && l < model.links.size(); ++l)
+    if (model.links[l].n() > 0) {
+      c.links[l].modes = m;
+      c.links[l].modes_line = 0;
+    }
+  return c;
+}
+
+// The series over modes: the full model first (the reference), then each m.
+RefineResult refine_modes(const Case& cs, const RefineRequest& rq, RefineResult res, const std::vector<JointInput>& inputs) {
+  const std::vector<Quantity>& qs = res.quantities;
+  const int n = rq.ns[0];
+  std::vector<int> ms{0};
+  ms.insert(ms.end(), rq.modes.begin(), rq.modes.end());
+  std::vector<std::vector<double>> values(qs.size());
+  res.status = RunStatus::completed();
+  for (size_t i = 0; i < ms.size(); ++i) {
+    const int m = ms[i];
+    if (rq.on_n) rq.on_n(static_cast<int>(i), static_cast<int>(ms.size()), m);
+    if (!evaluate_point(with_modes(cs, n, m), n, inputs, m ? fmt::format("m{}/", m) : std::string("full/"),
+                        "modes = " + std::to_string(m), rq, res, values))
+      break;
+  }
+  const size_t done = values.empty() ? 0 : values[0].size();
+  if (done > 0) res.ns = {n};
+  for (size_t i = 1; i < done; ++i) res.modes.push_back(ms[i]);
+  if (done > 0) res.modes.push_back(0);
+  for (size_t k = 0; k < qs.size(); ++k) {
+    Refinement t;
+    t.fitted_order = t.integration_error = NAN;
+    for (size_t i = 1; i < done; ++i) t.rows.push_back({ms[i], values[k][i], values[k][i] - values[k][0], NAN, NAN});
+    if (done > 0) t.rows.push_back({0, values[k][0], 0.0, NAN, NAN});
+    res.tables.push_back(std::move(t));
+  }
+  return res;
+}
+
 }  // namespace
 
 std::vector<Quantity> check_refinement(const Case& cs, const RefineRequest& rq) {
   if (rq.quantities.empty()) throw CaseError("--quantity: give at least one quantity (see rfem refine --help)");
+  if (!rq.modes.empty()) {
+    if (rq.ns.size() != 1) throw CaseError("--n: a series over --modes takes one n (got " + std::to_string(rq.ns.size()) + ")");
+    if (rq.ns[0] < 1) throw CaseError("--n: must be a positive integer (got " + std::to_string(rq.ns[0]) + ")");
+    for (size_t i = 0; i < rq.modes.size(); ++i) {
+      if (rq.modes[i] < 1) throw CaseError("--modes: must be at least 1 (got " + std::to_string(rq.modes[i]) + "; the full model is the series' reference)");
+      if (i > 0 && rq.modes[i] <= rq.modes[i - 1])
+        throw CaseError("--modes: the values must increase (" + std::to_string(rq.modes[i - 1]) + " then " + std::to_string(rq.modes[i]) + ")");
+    }
+    if (build_model(cs, rq.ns[0]).n() == 0) throw CaseError("--modes: the case has no flexible link at n = " + std::to_string(rq.ns[0]));
+    std::vector<Quantity> qs;
+    for (const auto& text : rq.quantities) qs.push_back(parse_quantity(cs, text));
+    for (int m : rq.modes) build_model(with_modes(cs, rq.ns[0], m), rq.ns[0]);  // more modes than a link has fails here
+    return qs;
+  }
   if (rq.ns.size() < 2) throw CaseError("--n: refine needs at least two values");
   for (size_t i = 0; i < rq.ns.size(); ++i) {
     if (rq.ns[i] < 1) throw CaseError("--n: must be a positive integer (got " + std::to_string(rq.ns[i]) + ")");
@@ -61,23 +137,14 @@ RefineResult refine(const Case& cs, const RefineRequest& rq) {
   const std::vector<Quantity>& qs = res.quantities;
   res.dynamic = std::any_of(qs.begin(), qs.end(), [](const Quantity& q) { return q.dynamic(); });
   const std::vector<JointInput> inputs = res.dynamic ? joint_inputs(cs, rq.warn) : std::vector<JointInput>{};
+  if (!rq.modes.empty()) return refine_modes(cs, rq, std::move(res), inputs);
   const Case& study = cs;
   std::vector<std::vector<double>> values(qs.size());
   res.status = RunStatus::completed();
   for (size_t i = 0; i < rq.ns.size(); ++i) {
     const int n = rq.ns[i];
     if (rq.on_n) rq.on_n(static_cast<int>(i), static_cast<int>(rq.ns.size()), n);
-    std::vector<double> dyn;
-    if (res.dynamic) dyn = evaluate_dynamic(study, inputs, n, qs, fmt::format("n{}/", n), rq);
-    if (rq.stop.requested()) {
-      res.status = RunStatus::interrupted(rq.stop.signal());
-      break;
-    }
-    for (size_t k = 0; k < qs.size(); ++k) {
-      values[k].push_back(qs[k].dynamic() ? dyn[k] : evaluate_quantity(cs, n, qs[k], rq.rate));
-      if (!std::isfinite(values[k].back()))
-        throw std::runtime_error("n = " + std::to_string(n) + ": " + qs[k].text + " is not finite: check the case's values");
-    }
+    if (!evaluate_point(study, n, inputs, fmt::format("n{}/", n), "n = " + std::to_string(n), rq, res, values)) break;
     res.ns.push_back(n);
   }
   // The integration error of the finest run: the same n at tolerances 100 times tighter.

@@ -3,7 +3,9 @@
 // observed orders, Richardson values where the series can be trusted (solvers/refinement.hpp),
 // and — for dynamic quantities — the integration error of the finest run, from a rerun at
 // tolerances 100 times tighter. Dynamic quantities share one run of the procedure per n; only the
-// runs they name are run.
+// runs they name are run. With `modes`, a series over a reduced link's modes instead: at one n,
+// every flexible link reduced to m modes (link.modes = m, README "Reduced links") for each m, and
+// the full model, each row's change its distance from the full model's value.
 #include <functional>
 #include <string>
 #include <vector>
@@ -15,13 +17,16 @@
 namespace rfem {
 
 struct RefineRequest {
-  std::vector<int> ns;                  ///< strictly increasing, at least two
+  std::vector<int> ns;                  ///< strictly increasing, at least two (one with `modes`)
+  /// A series over modes instead of n (strictly increasing, each ≥ 1): rows m …, then 0 (the full model).
+  std::vector<int> modes;
   std::vector<std::string> quantities;  ///< at least one (studies/quantities.hpp)
   bool integration_check = true;        ///< rerun the finest n at 100× tighter tolerances
   JointRate rate;                       ///< for static and modal quantities
   int threads = 0;
   StopToken stop;                       ///< ends the study after the current run; rows done are kept
-  /// Before each n (index from 0, count, n; index = count for the integration check).
+  /// Before each n (index from 0, count, n; index = count for the integration check); with
+  /// `modes`, before each m (n the m; 0: the full model, first).
   std::function<void(int index, int count, int n)> on_n;
   std::function<void(const Progress&)> progress;  ///< inside each run
   std::vector<RunObserver*> observers;  ///< see every run ("n12/kinematic", "check_n24/run")
@@ -31,7 +36,10 @@ struct RefineRequest {
 struct RefineResult {
   std::vector<Quantity> quantities;
   std::vector<int> ns;                 ///< the n done (all, unless stopped)
-  std::vector<Refinement> tables;      ///< per quantity
+  /// Per quantity. With `modes`: a row per m done (RefinementRow::n the m; change: value − the full
+  /// model's; order, Richardson NaN) and the full model's row last (n = 0, change 0).
+  std::vector<Refinement> tables;
+  std::vector<int> modes;              ///< the m of the rows (0: the full model); empty for a series over n
   RunStatus status;                    ///< completed, or interrupted
   bool dynamic = false;                ///< some quantity needed runs
 };

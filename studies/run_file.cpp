@@ -50,7 +50,8 @@ RefineResult refine_into_file(const Case& cs, RefineRequest rq, const std::strin
   Hdf5Recorder recorder(file);
   rq.observers.insert(rq.observers.begin(), &recorder);
   const RefineResult res = refine(cs, rq);
-  file.write_refinement(rq.quantities, res.ns, res.tables, res.status);
+  if (res.modes.empty()) file.write_refinement(rq.quantities, res.ns, res.tables, res.status);
+  else file.write_refinement(rq.quantities, res.modes, res.tables, res.status, rq.ns[0]);
   file.close();
   return res;
 }

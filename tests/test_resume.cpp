@@ -155,7 +155,7 @@ TEST(Resume, ADigitalPdGoesOnFromItsHeldAndDelayedValues) {
   const RunResult rest = resume_case(plan, rq).at(0);
   ASSERT_TRUE(rest.completed()) << rest.status;
   EXPECT_EQ(ref.stats.steps, rest.stats.steps);
-  for (const std::string& name : {"joint_q", "joint_tau", "tip_deflection"}) {
+  for (const char* name : {"joint_q", "joint_tau", "tip_deflection"}) {
     const Table x = ref.series->table(name), y = rest.series->table(name);
     EXPECT_TRUE(x.data == y.data) << name << " differs";
   }

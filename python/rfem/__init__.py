@@ -285,12 +285,16 @@ class RefineResult(dict):
             ", ".join(f"{t['quantity']} order {t['fitted_order']:.3g}" for t in self["tables"]) + ">"
 
 
-def refine(case, ns, quantities, output=None, integration_check=True, rate=None, joint=1, threads=0, progress=None):
+def refine(case, ns, quantities, output=None, integration_check=True, rate=None, joint=1, threads=0, progress=None,
+           modes=None):
     """Quantities over an increasing series of n with observed orders and Richardson values
     (the quantities of `rfem refine`: "tip:uz", "bending-y:1", "peak:u1", "force/u1@10", …).
     Dynamic quantities share one run per n; `output` keeps every run and the tables in HDF5.
-    Ctrl-C raises RunInterrupted with the rows done in .result."""
-    out, error = _rfem._refine(case, ns, quantities, output, integration_check, rate, joint, threads, progress)
+    modes=[4, 8, 16] (`rfem refine --modes`): a series over modes instead, at the one n of `ns`:
+    every flexible link reduced to m modes, then the full model; each table's "modes" (0: full),
+    "value" and "change" (value − the full model's). Ctrl-C raises RunInterrupted with the rows
+    done in .result."""
+    out, error = _rfem._refine(case, ns, quantities, output, integration_check, rate, joint, threads, progress, modes)
     result = RefineResult(out)
     _raise(error, result)
     return result

@@ -532,10 +532,12 @@ def quantity_unit(q, joint_units=()):
 
 
 def _refine_tables(source):
-    """[(quantity, n, value, fitted order, reference or None, warnings)] and the status of a
-    refinement: an h5py `refine` group or an rfem.RefineResult."""
+    """[(sub, quantity, n, value, fitted order, reference or None, warnings, over)] and the status
+    of a refinement: an h5py `refine` group or an rfem.RefineResult. over: "n", or "modes" for a
+    series over modes (n then the modes m, 0 the full model)."""
     if isinstance(source, h5py.Group):
-        n_all = np.asarray(source["n"][:], dtype=float).ravel()
+        over = "n" if "n" in source else "modes"
+        n_all = np.asarray(source[over][:], dtype=float).ravel()
         subs = sorted((k for k in source if k.startswith("q") and isinstance(source[k], h5py.Group)),
                       key=lambda k: int(k[1:])) or [None]
         tables = []
@@ -545,7 +547,7 @@ def _refine_tables(source):
             ref = float(np.asarray(g.attrs["reference"]).ravel()[0]) if "reference" in g.attrs else None
             tables.append((sub, text_attr(g, "quantity", "value"), n_all[:len(v)], v,
                            float(np.asarray(g.attrs.get("fitted_order", np.nan)).ravel()[0]), ref,
-                           text_attr(g, "warnings", "")))
+                           text_attr(g, "warnings", ""), over))
         return tables, text_attr(source, "status", "completed")
     tables = []
     for k, t in enumerate(source["tables"]):
@@ -553,14 +555,29 @@ def _refine_tables(source):
         ref = t.get("reference")
         ref = float(ref) if ref is not None and np.isfinite(ref) else None
         fitted = t.get("fitted_order")
-        tables.append(("q%d" % k, t["quantity"], np.asarray(t["n"], dtype=float).ravel()[:len(v)], v,
-                       float(fitted) if fitted is not None else np.nan, ref, "\n".join(t.get("warnings", []))))
+        over = "n" if "n" in t else "modes"
+        tables.append(("q%d" % k, t["quantity"], np.asarray(t[over], dtype=float).ravel()[:len(v)], v,
+                       float(fitted) if fitted is not None else np.nan, ref, "\n".join(t.get("warnings", [])), over))
     return tables, str(source.get("status", "completed"))
 
 
-def _draw_refinement(ax, quantity, n, v, fitted, ref, warnings, status, case_name, joint_units):
+def _draw_refinement(ax, quantity, n, v, fitted, ref, warnings, over, status, case_name, joint_units):
     import matplotlib.ticker
     unit = quantity_unit(quantity, joint_units)
+    if over == "modes":  # reduced links: each m's distance from the full model (the row m = 0)
+        full = v[n == 0][0] if np.any(n == 0) else np.nan
+        x, err = n[n > 0], np.abs(v[n > 0] - full)
+        keep = (err > 0) & np.isfinite(err)
+        if np.any(keep):
+            ax.loglog(x[keep], err[keep], "o-", label="|value − full model's|")
+        finish(ax, "modes kept per flexible link (m)", "|%s − full model's| [%s]" % (quantity, unit))
+        if len(x):
+            ax.set_xticks(x)
+            ax.set_xticklabels(["%g" % t for t in x])
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.set_title("Reduced links%s: %s\nfull model %.10g %s%s" % (" of " + case_name if case_name else "", quantity, full, unit,
+                                                                   "" if status == "completed" else " (%s)" % status), fontsize="medium")
+        return
     if ref is not None:
         x, err = n, np.abs(v - ref)
         label, ylabel = "|value − Richardson value|", "|%s − reference| [%s]" % (quantity, unit)
@@ -719,7 +736,7 @@ def write(results, outdir=None, format="png", paper_signs=False, echo=None, note
             groups = [k for k in f if isinstance(f[k], h5py.Group)]
             case = os.path.splitext(os.path.basename(text_attr(f, "case_path")))[0]
             runs = {k: Run(f[k], k, case) for k in groups if "time" in f[k]}
-            has_refine = "refine" in groups and "n" in f["refine"] and "value" in f["refine"]
+            has_refine = "refine" in groups and ("n" in f["refine"] or "modes" in f["refine"]) and "value" in f["refine"]
             if text_attr(f, "procedure") == "sweep" and "quantities" in f:
                 os.makedirs(outdir, exist_ok=True)
                 save(_sweep_figures(f))
