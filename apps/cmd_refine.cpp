@@ -91,15 +91,11 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
     for (size_t k = 0; k < qs.size(); ++k) {
       nlohmann::json rows = nlohmann::json::array();
       for (const auto& r : res.tables[k].rows)
-        rows.push_back({{"n", r.n}, {"value", r.value}, {"change", num(r.change)}, {"order", num(r.order)},
-                        {"richardson", num(r.richardson)}});
-      if (!res.modes.empty())
-        for (size_t i = 0; i < rows.size(); ++i) {
-          rows[i].erase("n");
-          rows[i].erase("order");
-          rows[i].erase("richardson");
-          rows[i]["modes"] = res.modes[i];
-        }
+        if (res.modes.empty())
+          rows.push_back({{"n", r.n}, {"value", r.value}, {"change", num(r.change)}, {"order", num(r.order)},
+                          {"richardson", num(r.richardson)}});
+        else
+          rows.push_back({{"modes", r.n}, {"value", r.value}, {"change", num(r.change)}});  // (0: the full model)
       jq.push_back({{"quantity", qs[k].text}, {"rows", rows}, {"fitted_order", num(res.tables[k].fitted_order)},
                     {"integration_error", num(res.tables[k].integration_error)}, {"warnings", res.tables[k].warnings}});
     }

@@ -3,7 +3,8 @@
 procedure (cases/paper_deployment.toml) with link 3 kept whole and reduced to m modes, at one n and
 thread count. Per m and run (kinematic, force): the median wall time over --repeat runs, steps,
 residual evaluations, the ratio of the wall time to the full model's kinematic run at the default
-tolerances (issue 35's goal: the reduced force run ≤ 1.5×), and the peaks of u1, u2, θ against the
+tolerances (what a reduced link is for: force input at about the kinematic run's cost; the aim
+is ≤ 1.5×), and the peaks of u1, u2, θ against the
 full model's at the default tolerances (relative).
 --atol: absolute tolerances [m, rad] to run every configuration at (simulation.atol; default
 1e-10). The steps of a force run are set by it, not by rtol: the rfe coordinates oscillate about

@@ -140,7 +140,7 @@ Projection::Projection(const Reduction& red, const BorderedPattern& pattern) : r
     for (SparseMat::InnerIterator it(S_, c); it; ++it) {
       const int r = static_cast<int>(it.row());
       if (to[r] >= 0 && to[c] >= 0) {
-        add(to[r], to[c], Source{0, static_cast<int>(&it.value() - S_.valuePtr()), 0, 0, 0});
+        add(to[r], to[c], Source{Source::S, 0, static_cast<int>(&it.value() - S_.valuePtr()), 0});
       } else if (to[r] >= 0 && link_of_[c] >= 0) {
         kept_link[static_cast<size_t>(r) * L + link_of_[c]] = 1;
       } else if (link_of_[r] >= 0 && link_of_[c] >= 0) {
@@ -151,14 +151,14 @@ Projection::Projection(const Reduction& red, const BorderedPattern& pattern) : r
     for (int l = 0; l < L; ++l)
       if (to[r] >= 0 && kept_link[static_cast<size_t>(r) * L + l])
         for (int c = 0; c < links[l].phi.cols(); ++c) {
-          add(to[r], links[l].first + c, Source{1, r, 0, l, c});
-          add(links[l].first + c, to[r], Source{1, r, 0, l, c});
+          add(to[r], links[l].first + c, Source{Source::W, l, r, c});
+          add(links[l].first + c, to[r], Source{Source::W, l, r, c});  // (S symmetric)
         }
   for (int l = 0; l < L; ++l)
     for (int l2 = 0; l2 < L; ++l2)
       if (pair[static_cast<size_t>(l * L + l2)])
         for (int a = 0; a < links[l].phi.cols(); ++a)
-          for (int c = 0; c < links[l2].phi.cols(); ++c) add(links[l].first + a, links[l2].first + c, Source{2, a, l, l2, c});
+          for (int c = 0; c < links[l2].phi.cols(); ++c) add(links[l].first + a, links[l2].first + c, Source{Source::G, l * L + l2, a, c});
   R_.resize(nr, nr);
   R_.setFromTriplets(rt.begin(), rt.end());  // (each entry once)
   source_.resize(static_cast<size_t>(R_.nonZeros()));
@@ -195,7 +195,8 @@ const SparseMat& Projection::reduce(const std::vector<double>& values) {
   double* out = R_.valuePtr();
   for (size_t k = 0; k < source_.size(); ++k) {
     const Source& s = source_[k];
-    out[k] = s.kind == 0 ? v[s.a] : s.kind == 1 ? W_[static_cast<size_t>(s.l)](s.a, s.c) : G_[static_cast<size_t>(s.b * L + s.l)](s.a, s.c);
+    out[k] = s.kind == Source::S ? v[s.a] : s.kind == Source::W ? W_[static_cast<size_t>(s.block)](s.a, s.c)
+                                                                : G_[static_cast<size_t>(s.block)](s.a, s.c);
   }
   return R_;
 }

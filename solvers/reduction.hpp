@@ -84,9 +84,10 @@ class Projection {
   const SparseMat& reduce(const std::vector<double>& values);
 
  private:
-  struct Source {         // where a reduced entry's value comes from
-    int kind = 0;         // 0: S's value `a`; 1: W_l(row a, col c); 2: (Φ_lᵀ W_l')(row a, col c) with l = b
-    int a = 0, b = 0, l = 0, c = 0;
+  struct Source {      // where a reduced entry's value comes from
+    enum Kind { S, W, G } kind = S;
+    int block = 0;     // W: the link l of W_l; G: the pair of G_ (l·links + l')
+    int a = 0, c = 0;  // S: S_'s value a; W, G: (row a, column c) of the block
   };
   const Reduction* red_ = nullptr;
   SparseMat S_, R_;
