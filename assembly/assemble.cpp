@@ -113,7 +113,7 @@ void generalised_forces(const Model& model, const VecX& q, const VecX& v, const 
   const int nchunks = ws.chunks(model);
   // One pass per chunk: rfe k's pose and forces, then sde k (rfes k−1, k) with both rotations —
   // each rotation is evaluated once, except the one of the rfe before the chunk.
-#pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(model.n()))
+#pragma omp parallel for schedule(static) num_threads(ws.parallel.team(model.n()))
   for (int c = 0; c < nchunks; ++c) {
     const Workspace::Chunk ch = ws.chunk[c];
     const MountedLink& L = model.links[ch.link];
@@ -121,7 +121,10 @@ void generalised_forces(const Model& model, const VecX& q, const VecX& v, const 
     const LinkFrame& fr = bk.frame[ch.link];
     DeformationTransform dt;
     RfeRotation left = ch.begin > 0 ? rotation_of(rfe_coords(model, q, ch.link, ch.begin - 1)) : clamp_rotation();
-    BaseMoments& mom = ws.moments[c];
+    // Partial sums in locals, stored once per chunk: neighbouring chunks' slots share cache lines,
+    // and a write per rfe from two threads makes the lines ping-pong (false sharing).
+    BaseMoments mom;
+    double power = 0.0;
     const Mat3 R0 = fr.B0.topLeftCorner<3, 3>();
     for (int k = ch.begin; k < ch.end; ++k) {
       if (L.carries(k)) continue;  // a node's body; its sdes come after the loop
@@ -152,10 +155,12 @@ void generalised_forces(const Model& model, const VecX& q, const VecX& v, const 
           F.segment<6>(model.rfe_index(ch.link, k - 1)) += r.f.head<6>();
         }
         F.segment<6>(ik) += r.f.tail<6>();
-        ws.power[c] += r.P_d;
+        power += r.P_d;
       }
       left = right;
     }
+    ws.moments[c] = mom;
+    ws.power[c] = power;
   }
   double Pd = 0.0;
   for (int c = 0; c < nchunks; ++c) {
@@ -278,7 +283,7 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
   std::vector<int> unknown_ancestors(model.links.size(), 0);  // a chain's border columns that are mass rows
   for (size_t l = 0; l < model.links.size(); ++l)
     for (int i : model.links[l].ancestors) unknown_ancestors[l] += col[i] >= 0;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(model.n()))
+#pragma omp parallel for schedule(static) num_threads(ws.parallel.team(model.n()))
   for (int c = 0; c < nchunks; ++c) {
     const Workspace::Chunk ch = ws.chunk[c];
     const MountedLink& L = model.links[ch.link];
@@ -292,6 +297,7 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
     Mat4 G;
     Mat12 Ke, Ce, A;
     DeformationTransform left;  // the rfe before, for the sde between them
+    BaseMoments mom;            // stored once at the chunk's end (see generalised_forces)
     if (sdes)
       deformation_transform(ch.begin > 0 ? rfe_coords(model, q, ch.link, ch.begin - 1) : Vec6::Zero().eval(), left, true);
     for (int k = ch.begin; k < ch.end; ++k) {
@@ -306,8 +312,8 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
       for (const auto& x : extra) std::fill_n(x.values->data() + pattern.diag(b), pattern.block_size(b), 0.0);
       rfe_pose(rfe, fr, q.segment<6>(ik), v.segment<6>(ik), zero.segment<6>(ik), pose, t.inertial, second);
       rfe_mass_blocks(rfe, pose, bk.Xi, anc, Mkk, border, G);
-      ws.moments[c].G += G;
-      ws.moments[c].s += pose.W * rfe.H.col(3);
+      mom.G += G;
+      mom.s += pose.W * rfe.H.col(3);
       Mat6 blk = t.mass * Mkk;
       border *= t.mass;
       if (base_rows)
@@ -346,6 +352,7 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
       }
       left = pose.d;
     }
+    ws.moments[c] = mom;
   }
   if (sdes)
     for (int c = 0; c < nchunks; ++c) {
@@ -445,12 +452,13 @@ Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* w
   }
   const int nchunks = ws.chunks(model);
   std::vector<Eigen::Vector4d> part(nchunks, Eigen::Vector4d::Zero());  // T, V_g, V_e, P_d per chunk
-#pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(model.n()))
+#pragma omp parallel for schedule(static) num_threads(ws.parallel.team(model.n()))
   for (int c = 0; c < nchunks; ++c) {
     const Workspace::Chunk ch = ws.chunk[c];
     const MountedLink& L = model.links[ch.link];
     const Discretisation& d = L.d;
     RfePose pose;
+    Eigen::Vector4d chunk_sum = Eigen::Vector4d::Zero();  // stored once (see generalised_forces)
     for (int k = ch.begin; k < ch.end; ++k) {
       if (L.carries(k)) continue;
       const int ik = model.rfe_index(ch.link, k);
@@ -461,9 +469,10 @@ Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* w
         sde_forces(s, left_centre(d, s), d.rfes[k].centre, d.damping_beta, left_coords(model, q, ch.link, k),
                    left_coords(model, v, ch.link, k), q.segment<6>(ik), v.segment<6>(ik), r);
       }
-      part[c] += Eigen::Vector4d(rfe_kinetic_energy(d.rfes[k], pose, bk.frame[ch.link], v.segment<6>(ik)),
-                                 model.gravity * (pose.W * d.rfes[k].H.col(3))[2], r.V, r.P_d);
+      chunk_sum += Eigen::Vector4d(rfe_kinetic_energy(d.rfes[k], pose, bk.frame[ch.link], v.segment<6>(ik)),
+                             model.gravity * (pose.W * d.rfes[k].H.col(3))[2], r.V, r.P_d);
     }
+    part[c] = chunk_sum;
   }
   Eigen::Vector4d sum = Eigen::Vector4d::Zero();
   for (const auto& p : part) sum += p;  // chunk order: the same bits for any thread count

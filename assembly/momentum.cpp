@@ -34,22 +34,27 @@ Momentum momentum(const Model& model, const VecX& q, const VecX& v, Workspace* w
   const int nchunks = ws.chunks(model);
   std::vector<Eigen::Matrix<double, 3, 4>> part(nchunks, Eigen::Matrix<double, 3, 4>::Zero());  // [A | lin]
   std::vector<Vec4> first(nchunks, Vec4::Zero());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(ws.parallel.team(model.n()))
+#pragma omp parallel for schedule(static) num_threads(ws.parallel.team(model.n()))
   for (int c = 0; c < nchunks; ++c) {
     const Workspace::Chunk ch = ws.chunk[c];
     const MountedLink& L = model.links[ch.link];
     RfePose pose;
     Vec3 l;
     Mat3 a;
+    // Sums in locals, stored once: neighbouring chunks' slots share cache lines (false sharing).
+    Eigen::Matrix<double, 3, 4> sum = Eigen::Matrix<double, 3, 4>::Zero();
+    Vec4 s1 = Vec4::Zero();
     for (int k = ch.begin; k < ch.end; ++k) {
       if (L.carries(k)) continue;  // a node's body
       const int ik = model.rfe_index(ch.link, k);
       rfe_pose(L.d.rfes[k], bk.frame[ch.link], q.segment<6>(ik), v.segment<6>(ik), ws.zero.segment<6>(ik), pose, false);
       rfe_momentum_moments(L.d.rfes[k], pose, bk.frame[ch.link], v.segment<6>(ik), l, a);
-      part[c].leftCols<3>() += a;
-      part[c].col(3) += l;
-      first[c] += pose.W * L.d.rfes[k].H.col(3);
+      sum.leftCols<3>() += a;
+      sum.col(3) += l;
+      s1 += pose.W * L.d.rfes[k].H.col(3);
     }
+    part[c] = sum;
+    first[c] = s1;
   }
   for (int c = 0; c < nchunks; ++c) {  // chunk order: the same bits for any thread count
     A += part[c].leftCols<3>();

@@ -11,6 +11,12 @@ exponent p of wall ∝ n^p between the two largest n.
   /usr/bin/python3 bench/run_bench.py [--ns 600,2000,10000] [--threads 1,2,auto] [--repeat 3]
       [--cases deployment,spinup] [--set key=value …]
 Threads are pinned with OMP_PROC_BIND=close OMP_PLACES=cores.
+
+--speedup: instead of the table, the second core's worth per case and n, with the machine's ceiling
+beside it (a busy or throttled machine cannot hide a regression): rounds of one-thread run,
+two-thread run and two one-thread runs at once, interleaved; per run of the procedure the medians,
+the speed-up T1/T2 and the ceiling 2·T1/T_pair (2.0 when two processes run as fast as one alone).
+  /usr/bin/python3 bench/run_bench.py --speedup --ns 1000 --cases deployment --repeat 3
 """
 import argparse, json, math, os, subprocess, sys, tempfile
 
@@ -40,6 +46,52 @@ def run_measured(rfem, case, n, threads, tmp, sets):
         return json.loads(so.read()), usage.ru_maxrss / 1024.0
 
 
+def run_pair(rfem, case, n, tmp, sets):
+    """Two one-thread runs started together; returns both runs' JSON."""
+    env = dict(os.environ, OMP_PROC_BIND="close", OMP_PLACES="cores")
+    procs = []
+    for k in range(2):
+        out = os.path.join(tmp, f"pair{k}_{n}.h5")
+        cmd = [rfem, "--threads", "1", "run", case, "--n", str(n), "--json", "-o", out]
+        for x in sets:
+            cmd += ["--set", x]
+        procs.append((subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True), out, cmd))
+    res = []
+    for p, out, cmd in procs:
+        so, se = p.communicate()
+        if p.returncode != 0:
+            sys.exit(f"run_bench: {' '.join(cmd)} failed: {se.strip()}")
+        os.remove(out)
+        res.append(json.loads(so))
+    return res
+
+
+def speedup(a, ns):
+    """--speedup: T1, T2 and the ceiling measured beside them, medians of interleaved rounds."""
+    print(f"machine: {os.cpu_count()} cores, {os.uname().machine}, {os.uname().release}; "
+          f"median of {a.repeat} interleaved rounds (1 thread, 2 threads, two 1-thread runs at once)")
+    print(f"{'case':<11}{'run':<10}{'n':>6}{'1 thr [s]':>11}{'2 thr [s]':>11}{'speed-up':>10}{'pair [s]':>10}{'ceiling':>9}")
+    med = lambda x: sorted(x)[len(x) // 2]
+    with tempfile.TemporaryDirectory() as tmp:
+        for case in a.cases.split(","):
+            for n in ns:
+                t1, t2, tp = [], [], []
+                for _ in range(a.repeat):
+                    t1.append(run_measured(a.rfem, CASES[case], n, "1", tmp, a.set)[0])
+                    t2.append(run_measured(a.rfem, CASES[case], n, "2", tmp, a.set)[0])
+                    tp.extend(run_pair(a.rfem, CASES[case], n, tmp, a.set))
+                names = [r["name"] for r in t1[0]["runs"]] + ["total"]
+                for i, name in enumerate(names):
+                    def wall(js):
+                        runs = js["runs"]
+                        return sum(r["wall_time_s"] for r in runs) if name == "total" else runs[i]["wall_time_s"]
+                    w1, w2, wp = med([wall(j) for j in t1]), med([wall(j) for j in t2]), med([wall(j) for j in tp])
+                    if w1 < 0.1:
+                        continue  # (the rigid run: nothing to measure)
+                    print(f"{case:<11}{name:<10}{n:>6}{w1:>11.2f}{w2:>11.2f}{w1 / w2:>9.2f}×{wp:>10.2f}{2 * w1 / wp:>8.2f}×",
+                          flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--rfem", default=os.path.join(HERE, "..", "build", "apps", "rfem"))
@@ -48,8 +100,12 @@ def main():
     ap.add_argument("--cases", default="deployment,spinup")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--set", action="append", default=[], help="case override for every run (key.path=value)")
+    ap.add_argument("--speedup", action="store_true", help="the second core's speed-up beside the machine's ceiling")
     a = ap.parse_args()
     ns = [int(x) for x in a.ns.split(",")]
+    if a.speedup:
+        speedup(a, ns)
+        return
     ths = a.threads.split(",")
     print(f"machine: {os.cpu_count()} cores, {os.uname().machine}, {os.uname().release}; median of {a.repeat}")
     hdr = f"{'case':<11}{'run':<10}{'n':>6}{'thr':>5}{'wall [s]':>10}{'steps':>8}{'resid':>8}{'fact':>6}" \

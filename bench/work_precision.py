@@ -11,6 +11,11 @@ the torque is the applied one, so only u1, u2, θ count). Wall time is the integ
 
   /usr/bin/python3 bench/work_precision.py                         # the README's study (~1 h)
   /usr/bin/python3 bench/work_precision.py --ns 60 --threads 1     # a quick look
+  /usr/bin/python3 bench/work_precision.py --cases deployment --ns 60 --threads 1 \
+      --configs esdirk5,bdf2 --solvers chain,cholmod --name solvers   # integrator × linear solver
+--solvers: the Newton matrix's factorisation ([simulation] linear_solver: rfem's chain solver or
+CHOLMOD, the design card's path); every configuration runs with each, named "CONFIG+SOLVER" when
+more than one is given. --name: the output files' stem (NAME.md, NAME.csv, NAME.png).
 """
 import argparse
 import csv
@@ -75,16 +80,35 @@ def main():
     ap.add_argument("--threads", default="1,2")
     ap.add_argument("--out", default=os.path.join(ROOT, "bench", "results"))
     ap.add_argument("--timeout", type=float, default=1800.0, help="per run [s]; slower runs are left out")
-    ap.add_argument("--replot", action="store_true", help="only rewrite the table and plot from OUT/work_precision.csv")
+    ap.add_argument("--configs", default=",".join(c[0] for c in DEFAULT_CONFIGS), help="integrator configurations")
+    ap.add_argument("--solvers", default="chain", help="linear solvers: chain, cholmod or both")
+    ap.add_argument("--rtols", default=None, help="override every configuration's rtols (comma-separated)")
+    ap.add_argument("--name", default="work_precision", help="stem of the output files")
+    ap.add_argument("--replot", action="store_true", help="only rewrite the table and plot from OUT/NAME.csv")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
+    known = {c[0]: c for c in DEFAULT_CONFIGS}
+    solvers = args.solvers.split(",")
+    for x in solvers:
+        if x not in ("chain", "cholmod"):
+            sys.exit(f"work_precision: --solvers: unknown linear solver '{x}' (chain, cholmod)")
+    configs = []
+    for name in args.configs.split(","):
+        if name not in known:
+            sys.exit(f"work_precision: --configs: unknown configuration '{name}' ({', '.join(known)})")
+        _, sets, rtols = known[name]
+        if args.rtols:
+            rtols = [float(x) for x in args.rtols.split(",")]
+        for solver in solvers:
+            label = name if len(solvers) == 1 else f"{name}+{solver}"
+            configs.append((label, sets + [f'simulation.linear_solver="{solver}"'], rtols))
     if args.replot:
-        with open(os.path.join(args.out, "work_precision.csv")) as fh:
+        with open(os.path.join(args.out, args.name + ".csv")) as fh:
             rows = [{k: (v if k in ("case", "run", "config") else float(v)) for k, v in r.items()} for r in csv.DictReader(fh)]
         for r in rows:
             for k in ("n", "threads", "steps", "residuals"):
                 r[k] = int(r[k])
-        write(rows, args.out)
+        write(rows, args.out, args.name)
         return
     rows = []
     for cname in args.cases.split(","):
@@ -107,13 +131,13 @@ def main():
                 print(f"{cname} n={n} {run}: reference error bound " + " ".join(f"{k}={v:.1e}" for k, v in e.items()))
                 rows.append(dict(case=cname, n=n, run=run, config="reference B vs A", rtol=1e-10, threads=0, wall=np.nan,
                                  steps=0, residuals=0, **e))
-            for cfg, sets, rtols in DEFAULT_CONFIGS:
+            for cfg, sets, rtols in configs:
                 for rtol in rtols:
                     for threads in [int(x) for x in args.threads.split(",")]:
                         out = os.path.join(args.out, "last.h5")
                         js = rfem_run(args.rfem, case, n, sets + tolerances(rtol), out, threads, args.timeout)
                         if not js:
-                            print(f"{cname} n={n} {cfg} rtol={rtol:.0e} threads={threads}: failed or timed out")
+                            print(f"{cname} n={n} {cfg} rtol={rtol:.0e} threads={threads}: failed or timed out", flush=True)
                             continue
                         f = h5py.File(out, "r")
                         for r in js["runs"]:
@@ -129,16 +153,16 @@ def main():
                         f.close()
             for r in refs.values():
                 r.close()
-    write(rows, args.out)
+    write(rows, args.out, args.name)
 
 
-def write(rows, out):
+def write(rows, out, name="work_precision"):
     keys = ["case", "n", "run", "config", "rtol", "threads", "wall", "steps", "residuals", "u1", "u2", "theta", "tau"]
-    with open(os.path.join(out, "work_precision.csv"), "w", newline="") as fh:
+    with open(os.path.join(out, name + ".csv"), "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=keys)
         w.writeheader()
         w.writerows(rows)
-    with open(os.path.join(out, "work_precision.md"), "w") as fh:
+    with open(os.path.join(out, name + ".md"), "w") as fh:
         fh.write("| case | n | run | integrator | rtol | threads | wall [s] | steps | residuals | u1 | u2 | θ | τ |\n")
         fh.write("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n")
         for r in rows:
@@ -175,7 +199,7 @@ def write(rows, out):
     axes[0][0].legend(fontsize=7)
     fig.suptitle("rfem work–precision: error against a converged reference vs wall time (dotted: 1e-4)", fontsize=10)
     fig.tight_layout()
-    fig.savefig(os.path.join(out, "work_precision.png"), dpi=110)
+    fig.savefig(os.path.join(out, name + ".png"), dpi=110)
 
 
 if __name__ == "__main__":

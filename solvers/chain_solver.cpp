@@ -188,7 +188,7 @@ bool ChainSolver::factorize(std::vector<double>& values) {
     const int ns = static_cast<int>(sweeps_.size());
     std::vector<char> ok(ns, 1);
     std::vector<MatX> schur(ns);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(2) if (parallel_)
+#pragma omp parallel for schedule(static, 1) num_threads(2) if (parallel_)
     for (int i = 0; i < ns; ++i) ok[i] = sweep_factor(v, sweeps_[i], schur[i]);
     for (int i = 0; i < ns; ++i)
       if (!ok[i]) return false;
@@ -263,7 +263,7 @@ void ChainSolver::solve(VecX& b) const {
   }
   const int ns = static_cast<int>(sweeps_.size());
   std::vector<VecX> y(ns);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(2) if (parallel_)
+#pragma omp parallel for schedule(static, 1) num_threads(2) if (parallel_)
   for (int i = 0; i < ns; ++i) sweep_forward(sweeps_[i], b, y[i]);
   for (int i = 0; i < ns; ++i)  // fixed order
     for (int a = 0; a < y[i].size(); ++a) rhs[iface_index(sweeps_[i].chain, a)] -= y[i][a];
@@ -272,7 +272,7 @@ void ChainSolver::solve(VecX& b) const {
   b.segment(n6, nb_) = x.tail(nb_);
   std::vector<VecX> xc(nc_);
   for (int c = 0; c < nc_; ++c) xc[c] = gather(c, x);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(2) if (parallel_)
+#pragma omp parallel for schedule(static, 1) num_threads(2) if (parallel_)
   for (int i = 0; i < ns; ++i) sweep_backward(sweeps_[i], b, xc[sweeps_[i].chain]);
 }
 

@@ -12,6 +12,7 @@
 #include "rfem/core/check.hpp"
 #include "rfem/solvers/mass_solve.hpp"
 #include "rfem/solvers/statics.hpp"
+#include "rfem/solvers/team_parts.hpp"
 
 namespace rfem {
 
@@ -92,10 +93,13 @@ void EquationsOfMotion::expand(double t, const double* qu, const double* vu, con
   q_.resize(N);
   v_.resize(N);
   a_.resize(N);
-  q_.head(n6) = Eigen::Map<const VecX>(qu, n6);
-  v_.head(n6) = Eigen::Map<const VecX>(vu, n6);
-  if (au) a_.head(n6) = Eigen::Map<const VecX>(au, n6);
-  else a_.setZero();
+  for_team_parts(n6, team(), [&](long b, long e) {
+    q_.segment(b, e - b) = Eigen::Map<const VecX>(qu + b, e - b);
+    v_.segment(b, e - b) = Eigen::Map<const VecX>(vu + b, e - b);
+    if (au) a_.segment(b, e - b) = Eigen::Map<const VecX>(au + b, e - b);
+    else a_.segment(b, e - b).setZero();
+  });
+  if (!au) a_.tail(N - n6).setZero();
   for (int i = n6; i < u; ++i) {
     q_[unknown_[i]] = qu[i];
     v_[unknown_[i]] = vu[i];
@@ -134,7 +138,7 @@ Power EquationsOfMotion::residual(double t, const double* qu, const double* vu, 
   const int n6 = model_->flexible_dofs();  // the first unknowns, in order
   if (reduction_) rf_.resize(u);
   double* full = reduction_ ? rf_.data() : r;
-  Eigen::Map<VecX>(full, n6) = F_.head(n6);
+  for_team_parts(n6, team(), [&](long b, long e) { Eigen::Map<VecX>(full + b, e - b) = F_.segment(b, e - b); });
   for (int i = n6; i < u; ++i) full[i] = F_[unknown_[i]];
   for (int j = 0; j < m; ++j)
     if (base_col_[j] >= 0) full[base_col_[j]] -= tau[j];

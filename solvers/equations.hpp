@@ -91,9 +91,11 @@ class EquationsOfMotion {
 
   NewtonSystem& newton() { return *newton_; }
   /// Solves with the Newton matrix of the last setup_newton (in place), on the kernels' team.
-  void solve_newton(VecX& b) const { newton_->solve(b, ws_.parallel.team(model_->n())); }
+  void solve_newton(VecX& b) const { newton_->solve(b, team()); }
   /// IDA's 2N system with that matrix (solvers/newton_system.hpp).
-  void solve_newton_bdf(const double* b, double* x) const { newton_->solve_bdf(b, x, ws_.parallel.team(model_->n())); }
+  void solve_newton_bdf(const double* b, double* x) const { newton_->solve_bdf(b, x, team()); }
+  /// The kernels' team now: the integrator's vector work runs on it too (solvers/team_parts.hpp).
+  int team() const { return ws_.parallel.team(model_->n()); }
   /// The thread policy of every kernel the equations run (results do not depend on it). With
   /// threads = 0 a ThreadGovernor picks one thread or all by timing the residual evaluations.
   const Parallelism& parallelism() const { return ws_.parallel; }

@@ -26,10 +26,13 @@
 
 #include "rfem/core/check.hpp"
 #include "rfem/solvers/esdirk_stepper.hpp"
+#include "rfem/solvers/team_parts.hpp"
 
 namespace rfem {
 
 namespace {
+
+constexpr int kMaxTeam = 64;  // the parts a reduction over the team keeps (a team is never larger)
 
 struct Tableau {
   int s = 0, order = 0, embedded_order = 0;
@@ -75,31 +78,48 @@ Tableau load_tableau(const std::string& name) {
 // Weighted max norm of a stage increment δα as the change it makes in [Q; V] = [(hγ)² δα; hγ δα];
 // NaN or inf if δα is not finite (then no test passes). Two vectorised reductions: a running
 // std::max over the unknowns was the integrator's largest serial cost.
-double wmax_increment(const VecX& da, double hg, const VecX& w) {
+// On the team (solvers/team_parts.hpp): a maximum is the same whatever the parts. With `update`,
+// also *update −= da in the same pass (one region fewer per Newton iteration; the caller discards
+// the update when the result is not finite).
+double wmax_increment(const VecX& da, double hg, const VecX& w, int team, VecX* update = nullptr) {
   const long u = da.size();
   if (u == 0) return 0.0;
-  const double mq = (da.array() * w.head(u).array()).abs().maxCoeff<Eigen::PropagateNaN>();
-  const double mv = (da.array() * w.tail(u).array()).abs().maxCoeff<Eigen::PropagateNaN>();
-  if (std::isnan(mq) || std::isnan(mv)) return mq + mv;  // (std::max would drop a NaN second argument)
+  double part[2][kMaxTeam] = {};
+  team = std::min(team, kMaxTeam);
+  for_team_parts(u, team, [&](long b, long e) {
+    const int t = team > 1 ? omp_get_thread_num() : 0;
+    if (e <= b) return;
+    const long n = e - b;
+    part[0][t] = (da.segment(b, n).array() * w.segment(b, n).array()).abs().maxCoeff<Eigen::PropagateNaN>();
+    part[1][t] = (da.segment(b, n).array() * w.segment(u + b, n).array()).abs().maxCoeff<Eigen::PropagateNaN>();
+    if (update) update->segment(b, n) -= da.segment(b, n);
+  });
+  double mq = 0.0, mv = 0.0;
+  for (int t = 0; t < team; ++t) {
+    if (std::isnan(part[0][t]) || std::isnan(part[1][t])) return part[0][t] + part[1][t];
+    mq = std::max(mq, part[0][t]);  // (std::max would drop a NaN second argument: tested above)
+    mv = std::max(mv, part[1][t]);
+  }
   return std::max(hg * hg * mq, hg * mv);
 }
 
 // out_k = x_k + Σ_{j<m} c_j y_j for two outputs over the same y's, in one pass over memory (blocks that
 // stay in cache); each element sums in the order of the vector operations it replaces (same bits).
 void combine(VecX& out1, const VecX& x1, const double* c1, VecX& out2, const VecX& x2, const double* c2,
-             const std::vector<VecX>& y, int m) {
-  const long u = x1.size();
-  constexpr long kBlock = 512;
-  for (long b0 = 0; b0 < u; b0 += kBlock) {
-    const long n = std::min(kBlock, u - b0);
-    auto o1 = out1.segment(b0, n), o2 = out2.segment(b0, n);
-    o1 = x1.segment(b0, n);
-    o2 = x2.segment(b0, n);
-    for (int j = 0; j < m; ++j) {
-      o1 += c1[j] * y[j].segment(b0, n);
-      o2 += c2[j] * y[j].segment(b0, n);
+             const std::vector<VecX>& y, int m, int team) {
+  for_team_parts(x1.size(), team, [&](long begin, long end) {
+    constexpr long kBlock = 512;
+    for (long b0 = begin; b0 < end; b0 += kBlock) {
+      const long n = std::min(kBlock, end - b0);
+      auto o1 = out1.segment(b0, n), o2 = out2.segment(b0, n);
+      o1 = x1.segment(b0, n);
+      o2 = x2.segment(b0, n);
+      for (int j = 0; j < m; ++j) {
+        o1 += c1[j] * y[j].segment(b0, n);
+        o2 += c2[j] * y[j].segment(b0, n);
+      }
     }
-  }
+  });
 }
 
 // Weighted RMS norm over [x_q; x_v] with weights w (size 2u).
@@ -226,12 +246,14 @@ struct EsdirkStepper::Impl {
   }
 
   void weights(const VecX& qa, const VecX& va, const VecX* qb, const VecX* vb) {
-    for (int i = 0; i < u; ++i) {
-      const double yq = qb ? std::max(std::abs(qa[i]), std::abs((*qb)[i])) : std::abs(qa[i]);
-      const double yv = vb ? std::max(std::abs(va[i]), std::abs((*vb)[i])) : std::abs(va[i]);
-      w[i] = 1.0 / (o.rtol * yq + o.atol);
-      w[u + i] = 1.0 / (o.rtol * yv + o.atol_velocity);
-    }
+    for_team_parts(u, eq.team(), [&](long b, long e) {
+      for (long i = b; i < e; ++i) {
+        const double yq = qb ? std::max(std::abs(qa[i]), std::abs((*qb)[i])) : std::abs(qa[i]);
+        const double yv = vb ? std::max(std::abs(va[i]), std::abs((*vb)[i])) : std::abs(va[i]);
+        w[i] = 1.0 / (o.rtol * yq + o.atol);
+        w[u + i] = 1.0 / (o.rtol * yv + o.atol_velocity);
+      }
+    });
   }
   RunStatus fail(const std::string& why) {
     char buf[200];
@@ -364,29 +386,35 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
       Ps[0] = P;
       for (int i = 1; i < s && converged; ++i) {
         const double ti = t + T.c[i] * h;
-        Q = q + (T.c[i] * h) * v;  // (Q is free until the Newton iteration)
+        const int team = eq.team();
+        for_team_parts(u, team, [&](long b, long e) {  // (Q is free until the Newton iteration)
+          Q.segment(b, e - b) = q.segment(b, e - b) + (T.c[i] * h) * v.segment(b, e - b);
+        });
         for (int j = 0; j < i; ++j) {
           cv[j] = h * T.A(i, j);
           cq[j] = h * h * T.AA(i, j);
         }
-        combine(Vk, v, cv.data(), Qk, Q, cq.data(), alpha, i);
+        combine(Vk, v, cv.data(), Qk, Q, cq.data(), alpha, i, team);
         alpha[i] = alpha[i - 1];  // predictor (extrapolations measured no better)
         double dn_prev = 0.0;
         eta = std::pow(std::max(eta, 1e-16), 0.8);
         converged = false;
         for (int it = 0; it < max_newton; ++it) {
-          V = Vk + hg * alpha[i];
-          Q = Qk + (hg * hg) * alpha[i];
+          for_team_parts(u, eq.team(), [&](long b, long e) {
+            V.segment(b, e - b) = Vk.segment(b, e - b) + hg * alpha[i].segment(b, e - b);
+            Q.segment(b, e - b) = Qk.segment(b, e - b) + (hg * hg) * alpha[i].segment(b, e - b);
+          });
           Ps[i] = eq.residual(ti, Q.data(), V.data(), alpha[i].data(), r.data());
           ++st.residual_evals;
           ++st.newton_iters;
           eq.solve_newton(r);  // −δα (a residual that is not finite gives a δα that is not)
-          const double dn = wmax_increment(r, hg, w);
+          // α_i −= δα with the increment's norm; a stage that is not finite is cut below (the
+          // next attempt starts α_i afresh from its predictor).
+          const double dn = wmax_increment(r, hg, w, eq.team(), &alpha[i]);
           if (!std::isfinite(dn)) {
             nonfinite = true;
             break;
           }
-          alpha[i] -= r;
           if (it > 0) {  // contraction rate; give up if it cannot make it within the iterations left
             const double theta = dn / dn_prev;
             if (theta >= 0.99) break;
@@ -416,14 +444,17 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
 
       // Solution (stiffly accurate: the last stage) and error estimate.
       VecX &q1 = Q, &v1 = V, &eqv = Qk, &evv = Vk;
-      Q = Qk + (hg * hg) * alpha[s - 1];  // q1
-      V = Vk + hg * alpha[s - 1];         // v1
+      const int team = eq.team();
+      for_team_parts(u, team, [&](long b, long e) {
+        Q.segment(b, e - b) = Qk.segment(b, e - b) + (hg * hg) * alpha[s - 1].segment(b, e - b);  // q1
+        V.segment(b, e - b) = Vk.segment(b, e - b) + hg * alpha[s - 1].segment(b, e - b);         // v1
+        r.segment(b, e - b).setZero();  // (free until the next stage)
+      });
       for (int j = 0; j < s; ++j) {
         cq[j] = h * h * T.eq[j];
         cv[j] = h * T.ev[j];
       }
-      r.setZero();  // (free until the next stage)
-      combine(eqv, r, cq.data(), evv, r, cv.data(), alpha, s);
+      combine(eqv, r, cq.data(), evv, r, cv.data(), alpha, s, team);
       weights(q, v, &q1, &v1);
       const double err = std::max(wrms(eqv, evv, w), 1e-10);
       const double expo = 1.0 / (T.embedded_order + 1);
@@ -484,9 +515,11 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
         steps_this_output = attempts_this_output = 0;
       }
       t = t1;
-      q = q1;
-      v = v1;
-      a = a1;
+      for_team_parts(u, eq.team(), [&](long b, long e) {
+        q.segment(b, e - b) = q1.segment(b, e - b);
+        v.segment(b, e - b) = v1.segment(b, e - b);
+        a.segment(b, e - b) = a1.segment(b, e - b);
+      });
       P = P1;
       Wd = Wd1;
       Wi = Wi1;

@@ -1,0 +1,30 @@
+#pragma once
+// The integrator's vector work on the residual's team: each thread takes one contiguous part of the
+// unknowns, the same part every call, the one whose rfes it evaluates in the residual (static
+// schedule over chunks) and eliminates in the chain solver (top and bottom sweeps). Done serially,
+// that work left the other core waiting, then re-reading from the first core's cache every line of
+// q, v, a it needed (docs/performance.md, "Two threads"). Elementwise work only: the same bits for
+// any team.
+#include <omp.h>
+
+namespace rfem {
+
+/// The first index of part t of [0, n) cut into T parts (at multiples of 8: a cache line of doubles).
+inline long team_part(long n, int t, int T) { return t >= T ? n : (n * t / T) / 8 * 8; }
+
+/// f(begin, end) for the parts of [0, n) on `team` threads (on the caller's alone if team ≤ 1).
+/// f runs inside an OpenMP region: it must not throw.
+template <class F>
+void for_team_parts(long n, int team, F&& f) {
+  if (team <= 1) {
+    f(0L, n);
+    return;
+  }
+#pragma omp parallel num_threads(team)
+  {
+    const int t = omp_get_thread_num(), T = omp_get_num_threads();
+    f(team_part(n, t, T), team_part(n, t + 1, T));
+  }
+}
+
+}  // namespace rfem
