@@ -470,7 +470,7 @@ Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* w
                    left_coords(model, v, ch.link, k), q.segment<6>(ik), v.segment<6>(ik), r);
       }
       chunk_sum += Eigen::Vector4d(rfe_kinetic_energy(d.rfes[k], pose, bk.frame[ch.link], v.segment<6>(ik)),
-                             model.gravity * (pose.W * d.rfes[k].H.col(3))[2], r.V, r.P_d);
+                                   model.gravity * (pose.W * d.rfes[k].H.col(3))[2], r.V, r.P_d);
     }
     part[c] = chunk_sum;
   }

@@ -1,7 +1,7 @@
 #pragma once
 // The integrator's vector work on the residual's team: each thread takes one contiguous part of the
-// unknowns, the same part every call, the one whose rfes it evaluates in the residual (static
-// schedule over chunks) and eliminates in the chain solver (top and bottom sweeps). Done serially,
+// unknowns, the same part every call — about the rfes it evaluates in the residual (static schedule
+// over chunks of 64 rfes) and eliminates in the chain solver (top and bottom sweeps). Done serially,
 // that work left the other core waiting, then re-reading from the first core's cache every line of
 // q, v, a it needed (docs/performance.md, "Two threads"). Elementwise work only: the same bits for
 // any team.
