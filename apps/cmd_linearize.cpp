@@ -2,7 +2,6 @@
 // its initial equilibrium or a saved state, into HDF5; prints its size and lowest frequencies.
 #include <fmt/core.h>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 
@@ -19,6 +18,7 @@ int run_linearize(const Common& c, const LinearizeOptions& o) {
   rq.n = c.n;
   rq.threads = c.threads > 0 ? c.threads : 1;
   rq.equilibrium = !o.on_motion;
+  rq.dense = o.dense;
   if (!o.state.empty()) {
     try {
       rq.state = std::make_shared<const SimulationState>(load_state(o.state));
@@ -39,14 +39,8 @@ int run_linearize(const Common& c, const LinearizeOptions& o) {
     file.close();
   }
   // The first-order model's eigenvalues: frequencies [Hz] and damping ratios of its lowest modes.
-  MatX A, B, C, D;
-  lin.state_space(A, B, C, D);
-  const Eigen::VectorXcd ev = Eigen::EigenSolver<MatX>(A, false).eigenvalues();
-  std::vector<std::pair<double, double>> modes;  // (f [Hz], ζ) of each pair with ω > 0
-  for (Eigen::Index i = 0; i < ev.size(); ++i)
-    if (ev[i].imag() > 0) modes.emplace_back(std::abs(ev[i]) / (2 * M_PI), -ev[i].real() / std::abs(ev[i]));
-  std::sort(modes.begin(), modes.end());
-  const int shown = std::min<int>(static_cast<int>(modes.size()), 6);
+  const std::vector<std::pair<double, double>> modes = linear_modes(lin, 6);
+  const int shown = static_cast<int>(modes.size());
   if (c.json) {
     nlohmann::json f = nlohmann::json::array(), z = nlohmann::json::array();
     for (int i = 0; i < shown; ++i) {
@@ -56,6 +50,7 @@ int run_linearize(const Common& c, const LinearizeOptions& o) {
     print_json({{"command", "linearize"}, {"case", cs.path}, {"output", o.output}, {"t", lin.t},
                 {"about", lin.equilibrium ? "equilibrium" : "state"}, {"states", lin.states.size()},
                 {"inputs", lin.inputs}, {"outputs", lin.outputs.size()}, {"imbalance", lin.imbalance},
+                {"evaluations", lin.evaluations}, {"nonzeros", {{"M", lin.M.nonZeros()}, {"D", lin.D.nonZeros()}, {"K", lin.K.nonZeros()}}},
                 {"frequencies_hz", f}, {"damping_ratios", z}});
     return 0;
   }
@@ -69,7 +64,9 @@ int run_linearize(const Common& c, const LinearizeOptions& o) {
   for (int i = 0; i < shown; ++i)
     fmt::print("  mode {}: {:.6g} Hz, damping ratio {:.3g}\n", i + 1, modes[static_cast<size_t>(i)].first,
                modes[static_cast<size_t>(i)].second);
-  fmt::print("wrote {} (group linear: M, D, K, B, Cq, Cv, Ca, A, Bs, C, Ds)\n", o.output);
+  const bool first_order = static_cast<int>(lin.states.size()) <= LinearModel::kFileDenseStates;
+  fmt::print("wrote {} (group linear: M, D, K, B sparse; Cq, Cv, Ca{}) from {} evaluations of the equations\n", o.output,
+             first_order ? "; A, Bs, C, Ds" : "", lin.evaluations);
   return 0;
 }
 

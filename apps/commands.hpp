@@ -74,6 +74,7 @@ struct LinearizeOptions {
   std::string output;     ///< -o LIN.h5
   std::string state;      ///< --state SAVED.h5: about a saved simulation state (default: the initial equilibrium)
   bool on_motion = false; ///< --on-motion: the state's own accelerations (default: at rest)
+  bool dense = false;     ///< --dense: column by column (the reference; O(n²))
 };
 /// `rfem linearize CASE -o LIN.h5`: the linear model into HDF5 (studies/linearize.hpp).
 int run_linearize(const Common& c, const LinearizeOptions& o);

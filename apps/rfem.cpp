@@ -166,6 +166,7 @@ int main(int argc, char** argv) {
   ln->add_option("-o,--output", lo.output, "HDF5 file for the matrices (group linear)")->required();
   ln->add_option("--state", lo.state, "about this saved simulation state (rfem.SimulationState.save; default: the initial equilibrium)");
   ln->add_flag("--on-motion", lo.on_motion, "with the state's own accelerations (default: at rest, the inputs that hold it in u0)");
+  ln->add_flag("--dense", lo.dense, "difference the equations column by column (the reference: 9 evaluations per state) instead of the sparse method");
   auto* sw = app.add_subcommand("sweep", "a parameter sweep: one run per point, quantities per run, one index (--jobs, or under mpirun)");
   SweepOptions so;
   bool sweep_json = false, sweep_quiet = false;

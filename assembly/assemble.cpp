@@ -86,6 +86,14 @@ void suffix_moments(const Model& model, const BaseKinematics& bk, const std::vec
   }
 }
 
+// A node's generalised force from the moments of everything it moves: rigid bodies through Y, the
+// rfes through their wrench and the node's unit twist, gravity through s (linear in the moments).
+double node_force(const Mat4& X, const BaseMoments& S, double g, bool inertia) {
+  double eps = 0.0;
+  if (inertia) eps = trace_prod(X, S.Y) + Vec3(X(2, 1), X(0, 2), X(1, 0)).dot(S.n) + X.topRightCorner<3, 1>().dot(S.f);
+  return eps + g * (X * S.s)[2];
+}
+
 // Each link's rfe moments, summed over its chunks in chunk order.
 std::vector<BaseMoments> link_moments(const Model& model, const Workspace& ws) {
   std::vector<BaseMoments> flex(model.links.size());
@@ -186,11 +194,7 @@ void generalised_forces(const Model& model, const VecX& q, const VecX& v, const 
   const std::vector<BaseMoments>& S = ws.node_moments;
   for (size_t i = 0; i < model.nodes.size(); ++i) {
     const Node& nd = model.nodes[i];
-    const Mat4& X = bk.Xi[i];
-    double eps = 0.0;
-    if (terms.inertia)  // rigid bodies through Y; the rfes through their wrench and the node's unit twist
-      eps = trace_prod(X, S[i].Y) + Vec3(X(2, 1), X(0, 2), X(1, 0)).dot(S[i].n) + X.topRightCorner<3, 1>().dot(S[i].f);
-    F[nd.coord] += eps + g * (X * S[i].s)[2];
+    F[nd.coord] += node_force(bk.Xi[i], S[i], g, terms.inertia);
     if (nd.joint < 0) continue;
     const JointDrive& dr = model.joints[nd.joint].drive;
     if (!dr.active()) continue;
@@ -202,6 +206,17 @@ void generalised_forces(const Model& model, const VecX& q, const VecX& v, const 
     }
   }
   if (dissipation) *dissipation = Pd;
+}
+
+void add_link_moments_to_nodes(const Model& model, const BaseKinematics& bk, int link, const BaseMoments& m,
+                               const ForceTerms& terms, VecX& F) {
+  RFEM_CHECK_INDEX(link, model.links.size(), "link");
+  RFEM_CHECK_ARGUMENT_SIZE(F.size(), model.dof(), "F");
+  RFEM_CHECK_ARGUMENT_SIZE(bk.Xi.size(), model.nodes.size(), "base kinematics");
+  const int parent = model.links[link].parent;
+  if (parent < 0) return;  // (a link on {0}: no node moves it)
+  const double g = terms.gravity ? model.gravity : 0.0;
+  for (int i : model.nodes[parent].path) F[model.nodes[i].coord] += node_force(bk.Xi[i], m, g, terms.inertia);
 }
 
 namespace {

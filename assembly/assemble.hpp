@@ -28,6 +28,14 @@ struct ForceTerms {
 void generalised_forces(const Model& model, const VecX& q, const VecX& v, const VecX& a,
                         const ForceTerms& terms, VecX& F, double* dissipation = nullptr, Workspace* ws = nullptr);
 
+/// What rfe moments `m` of link `link` (a chunk's as generalised_forces sums them into the
+/// workspace, or a change of them) add to the rows of the nodes that move the link, with the base
+/// kinematics `bk` of that evaluation: the same terms as generalised_forces, linear in m. The
+/// linear models (studies/linear_jacobian.hpp) split a change of the node rows among the rfes
+/// that caused it this way.
+void add_link_moments_to_nodes(const Model& model, const BaseKinematics& bk, int link, const BaseMoments& m,
+                               const ForceTerms& terms, VecX& F);
+
 /// Coefficients of the matrix S = mass·M + damping·C + stiffness·K assembled into the pattern.
 /// K holds the sde stiffness (with its geometric term), and on request the gravity stiffness and
 /// the centrifugal (inertial) stiffness of the rfe blocks at the base velocity in v. M includes

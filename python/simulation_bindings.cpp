@@ -186,10 +186,10 @@ void bind_simulation(py::module_& m) {
       })
       .def("snapshot", [](PySimulation& p) { return snapshot_dict(p.sim->snapshot(), p.sim->model()); })
       .def("state", [](const PySimulation& p) { return p.sim->state(); })
-      .def("linearize", [](PySimulation& p, py::handle equilibrium) {
-        const bool eq = args::flag(equilibrium, "equilibrium");
+      .def("linearize", [](PySimulation& p, py::handle equilibrium, py::handle dense) {
+        const bool eq = args::flag(equilibrium, "equilibrium"), d = args::flag(dense, "dense");
         py::gil_scoped_release release;
-        return std::make_shared<LinearModel>(p.sim->linearize(eq));
+        return std::make_shared<LinearModel>(p.sim->linearize(eq, d));
       })
       .def("finish", [](PySimulation& p) {
         std::shared_ptr<RunResult> r;
@@ -211,10 +211,11 @@ void bind_simulation(py::module_& m) {
       .def_readonly("inputs", &LinearModel::inputs, "free joints: a torque [N m] (force [N]) added to each")
       .def_readonly("outputs", &LinearModel::outputs, "LINK/tip_u1 … tip_theta, JOINT/q, v, tau, sensor columns")
       .def_readonly("output_units", &LinearModel::output_units)
-      .def_property_readonly("M", [](const LinearModel& l) { return l.M; }, "states × states [kg, kg m, kg m²]")
-      .def_property_readonly("D", [](const LinearModel& l) { return l.D; }, "states × states: damping, PD kd, gyroscopic")
-      .def_property_readonly("K", [](const LinearModel& l) { return l.K; }, "states × states: elastic, geometric, gravity, centrifugal, PD kp")
-      .def_property_readonly("B", [](const LinearModel& l) { return l.B; }, "states × inputs")
+      .def_property_readonly("M", [](const LinearModel& l) { return l.M; }, "states × states [kg, kg m, kg m²] (scipy.sparse CSC)")
+      .def_property_readonly("D", [](const LinearModel& l) { return l.D; }, "states × states: damping, PD kd, gyroscopic (sparse)")
+      .def_property_readonly("K", [](const LinearModel& l) { return l.K; }, "states × states: elastic, geometric, gravity, centrifugal, PD kp (sparse)")
+      .def_property_readonly("B", [](const LinearModel& l) { return l.B; }, "states × inputs (sparse)")
+      .def_readonly("evaluations", &LinearModel::evaluations, "evaluations of the equations it took")
       .def_property_readonly("Cq", [](const LinearModel& l) { return l.Cq; }, "outputs × states")
       .def_property_readonly("Cv", [](const LinearModel& l) { return l.Cv; }, "outputs × states")
       .def_property_readonly("Ca", [](const LinearModel& l) { return l.Ca; }, "outputs × states")
@@ -231,7 +232,15 @@ void bind_simulation(py::module_& m) {
           l.state_space(A, B, C, D);
         }
         return py::make_tuple(A, B, C, D);
-      }, "(A, B, C, D) of x' = A x + B u, y = C x + D u with x = (q, q'): 2N states")
+      }, "(A, B, C, D) of x' = A x + B u, y = C x + D u with x = (q, q'): 2N states, dense (up to 3000 states)")
+      .def("modes", [](const LinearModel& l, int count) {
+        std::vector<std::pair<double, double>> m;
+        {
+          py::gil_scoped_release release;
+          m = linear_modes(l, count);
+        }
+        return m;
+      }, py::arg("count") = 6, "the lowest modes of A: [(f [Hz], damping ratio)], one per oscillating pair")
       .def_property_readonly("first_order_states", &LinearModel::first_order_states)
       .def("__repr__", [](const LinearModel& l) {
         return "<rfem.LinearModel " + std::to_string(l.states.size()) + " states, " + std::to_string(l.inputs.size()) + " inputs, " +
@@ -239,13 +248,14 @@ void bind_simulation(py::module_& m) {
                py::repr(py::float_(l.t)).cast<std::string>() + " s>";
       });
   m.def("_linearize", [](py::handle case_arg, py::handle n, py::handle state, py::handle threads, py::handle equilibrium,
-                         py::handle output_arg, const std::string& made_by) {
+                         py::handle output_arg, const std::string& made_by, py::handle dense) {
     const args::CaseArg cs_arg(case_arg);
     const Case& cs = *cs_arg;
     LinearizeRequest rq;
     rq.n = args::rfes(n);
     rq.threads = args::threads(threads);
     rq.equilibrium = args::flag(equilibrium, "equilibrium");
+    rq.dense = args::flag(dense, "dense");
     if (!state.is_none()) {
       if (!py::isinstance<SimulationState>(state)) args::type_error("state", "an rfem.SimulationState or None", state);
       rq.state = std::make_shared<const SimulationState>(state.cast<SimulationState>());
@@ -259,7 +269,7 @@ void bind_simulation(py::module_& m) {
       file.close();
     }
     return lin;
-  }, py::arg("case"), py::arg("n"), py::arg("state"), py::arg("threads"), py::arg("equilibrium"), py::arg("output"), py::arg("made_by"));
+  }, py::arg("case"), py::arg("n"), py::arg("state"), py::arg("threads"), py::arg("equilibrium"), py::arg("output"), py::arg("made_by"), py::arg("dense"));
 
   m.def("_run_controlled", [](py::handle case_arg, py::handle n, py::handle threads, py::handle output, py::handle keep_series,
                               std::optional<SimulationState> state, const std::string& made_by, py::object controller,

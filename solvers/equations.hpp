@@ -52,6 +52,8 @@ class EquationsOfMotion {
   EquationsOfMotion& operator=(const EquationsOfMotion&) = delete;
   const Model& model() const { return *model_; }
   const std::vector<JointInput>& inputs() const { return inputs_; }
+  /// The generalised forces' terms the residual includes.
+  const ForceTerms& terms() const { return terms_; }
   /// Number of unknown coordinates (size of q_u).
   int unknowns() const { return nu_; }
   /// Joint j's column among the unknowns, −1 if prescribed.

@@ -1,6 +1,14 @@
 #include "rfem/studies/linearize.hpp"
 
-#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+// (GCC 12 sees a use after free inside Spectra's Hessenberg eigenvectors, which are not computed here)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuse-after-free"
+#include <Spectra/GenEigsRealShiftSolver.h>
+#pragma GCC diagnostic pop
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -12,12 +20,7 @@
 namespace rfem {
 
 namespace {
-// Central differences in q and q̇ at h and 2h, extrapolated (Richardson): truncation O(h⁴). The
-// residual is smooth there (trigonometric in the rotations, quadratic in the rates) but computed
-// from positions of the model's size, so round-off puts ~ε L / h into a column; h = 1e-5 [m, rad,
-// m/s, rad/s] keeps both near 1e-10 of it (Kane's beam: its frequencies within 3e-10 of rfem modes;
-// 1e-6 and 1e-4 measured alike, 1e-3 3e-10 from truncation).
-constexpr double kStep = 1e-5;
+constexpr double kStep = kLinearizationStep;
 
 Table table_of(const MatX& m) {
   Table t{m.rows(), m.cols(), std::vector<double>(static_cast<size_t>(m.size()))};
@@ -34,9 +37,7 @@ void linearize_about(const LinearEvaluation& f, const VecX& q0, const VecX& v0, 
   VecX r0, y0;
   f(q0, v0, a0, r0, y0);
   const Eigen::Index P = y0.size();
-  lin.M.resize(N, N);
-  lin.D.resize(N, N);
-  lin.K.resize(N, N);
+  MatX M(N, N), D(N, N), K(N, N);
   lin.Cq.resize(P, N);
   lin.Cv.resize(P, N);
   lin.Ca.resize(P, N);
@@ -59,30 +60,63 @@ void linearize_about(const LinearEvaluation& f, const VecX& q0, const VecX& v0, 
     C.col(i) = (8 * (yp - ym) - (y2p - y2m)) / (12 * kStep);
   };
   for (Eigen::Index i = 0; i < N; ++i) {
-    derivative(q, i, false, lin.K, lin.Cq);
-    derivative(v, i, true, lin.D, lin.Cv);
+    derivative(q, i, false, K, lin.Cq);
+    derivative(v, i, true, D, lin.Cv);
     a[i] = a0[i] + 1.0;  // (linear in q̈: one-sided and exact up to round-off)
     f(q0, v0, a, rp, yp);
     a[i] = a0[i];
-    lin.M.col(i) = rp - r0;
+    M.col(i) = rp - r0;
     lin.Ca.col(i) = yp - y0;
   }
-  lin.B = MatX::Zero(N, static_cast<Eigen::Index>(free_rows.size()));
+  lin.M = M.sparseView(1.0, 0.0);  // (exact zeros only)
+  lin.D = D.sparseView(1.0, 0.0);
+  lin.K = K.sparseView(1.0, 0.0);
+  lin.evaluations = static_cast<int>(9 * N + 1);
+  set_operating_point(lin, q0, v0, a0, r0, y0, free_rows, rfe_rows);
+}
+
+void set_operating_point(LinearModel& lin, const VecX& q0, const VecX& v0, const VecX& a0, const VecX& r0, const VecX& y0,
+                         const std::vector<int>& free_rows, int rfe_rows) {
+  const Eigen::Index N = q0.size();
+  lin.B.resize(N, static_cast<Eigen::Index>(free_rows.size()));
+  lin.B.setZero();
   lin.u0.resize(static_cast<Eigen::Index>(free_rows.size()));
   for (size_t k = 0; k < free_rows.size(); ++k) {
-    lin.B(free_rows[k], static_cast<Eigen::Index>(k)) = 1.0;
+    lin.B.insert(free_rows[k], static_cast<Eigen::Index>(k)) = 1.0;
     lin.u0[static_cast<Eigen::Index>(k)] = r0[free_rows[k]];
   }
+  lin.B.makeCompressed();
   lin.q0 = q0;
   lin.v0 = v0;
   lin.a0 = a0;
   lin.y0 = y0;
+  // The rfe rows' residual against the largest elastic (K over 1 mm) or weight (M g) term of their columns.
+  VecX colK = VecX::Zero(N), colM = VecX::Zero(N);
+  for (Eigen::Index c = 0; c < N; ++c) {
+    for (SparseMat::InnerIterator it(lin.K, c); it; ++it) colK[c] = std::max(colK[c], std::abs(it.value()));
+    for (SparseMat::InnerIterator it(lin.M, c); it; ++it) colM[c] = std::max(colM[c], std::abs(it.value()));
+  }
   double scale = 0.0, worst = 0.0;
   for (Eigen::Index i = 0; i < rfe_rows; ++i) {
     worst = std::max(worst, std::abs(r0[i]));
-    scale = std::max({scale, lin.K.col(i).cwiseAbs().maxCoeff() * 1e-3, lin.M.col(i).cwiseAbs().maxCoeff() * 9.81});
+    scale = std::max({scale, colK[i] * 1e-3, colM[i] * 9.81});
   }
   lin.imbalance = scale > 0 ? worst / scale : 0.0;
+}
+
+double directional_mismatch(const SparseMat& J, const VecX& w, const VecX& dJw, const VecX& noise, Eigen::Index* row) {
+  const VecX Jw = J * w;
+  const VecX size = J.cwiseAbs() * w.cwiseAbs();
+  const double floor = 1e-9 * size.maxCoeff();
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < Jw.size(); ++i) {
+    const double e = std::abs(Jw[i] - dJw[i]) / (size[i] + floor + 1e6 * noise[i] + 1e-300);
+    if (e > worst) {
+      worst = e;
+      if (row) *row = i;
+    }
+  }
+  return worst;
 }
 
 std::vector<std::string> LinearModel::first_order_states() const {
@@ -93,9 +127,14 @@ std::vector<std::string> LinearModel::first_order_states() const {
 
 void LinearModel::state_space(MatX& A, MatX& Bs, MatX& C, MatX& Ds) const {
   const Eigen::Index N = M.rows();
-  const Eigen::LLT<MatX> llt(M);
-  if (llt.info() != Eigen::Success) throw std::runtime_error("linear model: the mass matrix is not positive definite");
-  const MatX MK = llt.solve(K), MD = llt.solve(D), MB = llt.solve(B);
+  if (N > kMaxDenseStates)
+    throw std::invalid_argument("state_space: " + std::to_string(N) + " states make a dense A of " + std::to_string(2 * N) +
+                                "² values; above " + std::to_string(kMaxDenseStates) +
+                                " use M, D, K (sparse) or a reduced link (modes = m)");
+  const Eigen::SimplicialLDLT<SparseMat> ldlt(M);
+  if (ldlt.info() != Eigen::Success || (ldlt.vectorD().array() <= 0).any())
+    throw std::runtime_error("linear model: the mass matrix is not positive definite");
+  const MatX MK = ldlt.solve(MatX(K)), MD = ldlt.solve(MatX(D)), MB = ldlt.solve(MatX(B));
   A = MatX::Zero(2 * N, 2 * N);
   A.topRightCorner(N, N).setIdentity();
   A.bottomLeftCorner(N, N) = -MK;
@@ -108,27 +147,108 @@ void LinearModel::state_space(MatX& A, MatX& Bs, MatX& C, MatX& Ds) const {
   Ds = Ca * MB;
 }
 
+namespace {
+// Dense eigenvalues of A only for tiny models: QR's absolute error ε‖A‖ (‖A‖ ~ the highest ω²)
+// moves the lowest frequencies (~1e-5 relative at n = 100) and their real parts (1.5e-7 of a
+// damping ratio of 0.004 at n = 12); shift-invert finds them to round-off.
+constexpr Eigen::Index kDenseModes = 16;
+
+// (A − σI)⁻¹ for A = [0 I; −M⁻¹K −M⁻¹D] from the sparse pencil: with y2 = x1 + σ y1,
+// (K + σD + σ²M) y1 = −M x2 − (D + σM) x1 (Spectra's shift-solve operation).
+class PencilShiftSolve {
+ public:
+  using Scalar = double;
+  explicit PencilShiftSolve(const LinearModel& lin) : lin_(lin), n_(lin.M.rows()) {}
+  Eigen::Index rows() const { return 2 * n_; }
+  Eigen::Index cols() const { return 2 * n_; }
+  void set_shift(double sigma) {
+    sigma_ = sigma;
+    const SparseMat Q = lin_.K + sigma * lin_.D + sigma * sigma * lin_.M;
+    lu_.setPivotThreshold(0.01);  // (the diagonal unless it is 100× smaller than its column)
+    lu_.compute(Q);
+    if (lu_.info() != Eigen::Success) throw std::runtime_error("linear model modes: K + σD + σ²M is singular");
+  }
+  void perform_op(const double* x_in, double* y_out) const {
+    const Eigen::Map<const VecX> x1(x_in, n_), x2(x_in + n_, n_);
+    Eigen::Map<VecX> y1(y_out, n_), y2(y_out + n_, n_);
+    const VecX rhs = -(lin_.M * x2) - lin_.D * x1 - sigma_ * (lin_.M * x1);
+    y1 = lu_.solve(rhs);
+    y2 = x1 + sigma_ * y1;
+  }
+
+ private:
+  const LinearModel& lin_;
+  Eigen::Index n_;
+  double sigma_ = 0.0;
+  // The states' own order: every link's rfes in a chain, then what borders them (carrying rfes,
+  // modal coordinates, free joints) — no fill beyond the chains (COLAMD's order filled 40 M entries
+  // at 24 000 states, with the free joints' dense rows).
+  Eigen::SparseLU<SparseMat, Eigen::NaturalOrdering<int>> lu_;
+};
+}  // namespace
+
+std::vector<std::pair<double, double>> linear_modes(const LinearModel& lin, int count) {
+  if (count < 1) throw std::invalid_argument("count: must be 1 or more (got " + std::to_string(count) + ")");
+  const Eigen::Index N = lin.M.rows();
+  Eigen::VectorXcd ev;
+  if (N <= kDenseModes) {
+    MatX A, B, C, D;
+    lin.state_space(A, B, C, D);
+    ev = Eigen::EigenSolver<MatX>(A, false).eigenvalues();
+  } else {  // the eigenvalues nearest a small negative shift: the lowest modes, the rigid ones' zeros
+    PencilShiftSolve op(lin);
+    const Eigen::Index nev = std::min<Eigen::Index>(2 * count + 6, 2 * N - 3);
+    Spectra::GenEigsRealShiftSolver<PencilShiftSolve> es(op, nev, std::min<Eigen::Index>(2 * nev + 1, 2 * N), -0.1);
+    es.init();
+    es.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12);
+    if (es.info() != Spectra::CompInfo::Successful) throw std::runtime_error("linear model modes: the eigensolver did not converge");
+    ev = es.eigenvalues();
+  }
+  std::vector<std::pair<double, double>> modes;  // (f [Hz], ζ) of each pair with ω > 0
+  for (Eigen::Index i = 0; i < ev.size(); ++i)
+    if (ev[i].imag() > 0) modes.emplace_back(std::abs(ev[i]) / (2 * M_PI), -ev[i].real() / std::abs(ev[i]));
+  std::sort(modes.begin(), modes.end());
+  if (static_cast<int>(modes.size()) > count) modes.resize(static_cast<size_t>(count));
+  return modes;
+}
+
 void write_linear(ResultsWriter& file, const LinearModel& lin) {
+  const bool first_order = lin.M.rows() <= LinearModel::kFileDenseStates;
   MatX A, Bs, C, Ds;
-  lin.state_space(A, Bs, C, Ds);
+  if (first_order) lin.state_space(A, Bs, C, Ds);
   const std::vector<std::string> x = lin.first_order_states();
   auto put = [&](const std::string& name, const MatX& m, const std::vector<std::string>& rows, const std::vector<std::string>& cols,
                  const std::string& description) {
     file.write_table("linear/" + name, table_of(m), cols, std::vector<std::string>(cols.size(), ""), description);
     file.write_attribute("linear/" + name, "rows", rows);
   };
-  put("M", lin.M, lin.states, lin.states, "mass: M δq̈ + D δq̇ + K δq = B δu");
-  put("D", lin.D, lin.states, lin.states, "damping (sdes, drives, PD kd, gyroscopic)");
-  put("K", lin.K, lin.states, lin.states, "stiffness (elastic, geometric, gravity, centrifugal, PD kp)");
+  // Sparse: (row, column, value), 0-based — scipy.sparse.coo_matrix((v, (r, c))), MATLAB sparse(r+1, c+1, v, …).
+  auto put_sparse = [&](const std::string& name, const SparseMat& m, const std::vector<std::string>& rows,
+                        const std::vector<std::string>& cols, const std::string& description) {
+    Table t{static_cast<long>(m.nonZeros()), 3, {}};
+    t.data.reserve(static_cast<size_t>(3 * m.nonZeros()));
+    for (Eigen::Index c = 0; c < m.outerSize(); ++c)
+      for (SparseMat::InnerIterator it(m, c); it; ++it)
+        t.data.insert(t.data.end(), {static_cast<double>(it.row()), static_cast<double>(it.col()), it.value()});
+    t.rows = static_cast<long>(t.data.size() / 3);
+    file.write_table("linear/" + name, t, {"row", "column", "value"}, {"", "", ""}, description + " (sparse: 0-based row, column, value)");
+    file.write_attribute("linear/" + name, "rows", rows);
+    file.write_attribute("linear/" + name, "matrix_columns", cols);
+  };
+  put_sparse("M", lin.M, lin.states, lin.states, "mass: M δq̈ + D δq̇ + K δq = B δu");
+  put_sparse("D", lin.D, lin.states, lin.states, "damping (sdes, drives, PD kd, gyroscopic)");
+  put_sparse("K", lin.K, lin.states, lin.states, "stiffness (elastic, geometric, gravity, centrifugal, PD kp)");
   const bool inputs = !lin.inputs.empty();  // (a model with every joint prescribed has none)
-  if (inputs) put("B", lin.B, lin.states, lin.inputs, "input matrix: a torque (force) added at each free joint");
+  if (inputs) put_sparse("B", lin.B, lin.states, lin.inputs, "input matrix: a torque (force) added at each free joint");
   put("Cq", lin.Cq, lin.outputs, lin.states, "outputs: δy = Cq δq + Cv δq̇ + Ca δq̈");
   put("Cv", lin.Cv, lin.outputs, lin.states, "outputs' rate part");
   put("Ca", lin.Ca, lin.outputs, lin.states, "outputs' acceleration part");
-  put("A", A, x, x, "first order: ẋ = A x + Bs u, x = (δq, δq̇)");
-  if (inputs) put("Bs", Bs, x, lin.inputs, "first order input matrix");
-  put("C", C, lin.outputs, x, "first order: y = C x + Ds u");
-  if (inputs) put("Ds", Ds, lin.outputs, lin.inputs, "first order feed-through");
+  if (first_order) {
+    put("A", A, x, x, "first order: ẋ = A x + Bs u, x = (δq, δq̇)");
+    if (inputs) put("Bs", Bs, x, lin.inputs, "first order input matrix");
+    put("C", C, lin.outputs, x, "first order: y = C x + Ds u");
+    if (inputs) put("Ds", Ds, lin.outputs, lin.inputs, "first order feed-through");
+  }
   MatX op(3, lin.q0.size());
   op << lin.q0.transpose(), lin.v0.transpose(), lin.a0.transpose();
   put("operating_point", op, {"q", "v", "a"}, lin.states, "the state linearised about (unknowns)");
@@ -145,6 +265,9 @@ void write_linear(ResultsWriter& file, const LinearModel& lin) {
   file.write_attribute("linear", "inputs", lin.inputs.empty() ? std::vector<std::string>{"(none)"} : lin.inputs);
   file.write_attribute("linear", "outputs", lin.outputs);
   file.write_attribute("linear", "output_units", lin.output_units);
+  file.write_attribute("linear", "first_order",
+                       first_order ? "A, Bs, C, Ds" : "not written above " + std::to_string(LinearModel::kFileDenseStates) +
+                                                          " states: E x' = [0 I; -K -D] x + [0; B] u, E = [I 0; 0 M]");
 }
 
 LinearModel linearize(const Case& cs, const LinearizeRequest& rq) {
@@ -157,7 +280,7 @@ LinearModel linearize(const Case& cs, const LinearizeRequest& rq) {
   o.state = rq.state;
   Simulation sim(c, std::move(o));
   if (sim.status().kind != RunStatus::Kind::Running) throw std::runtime_error("cannot linearise: " + sim.status().to_string());
-  LinearModel lin = sim.linearize(rq.equilibrium);
+  LinearModel lin = sim.linearize(rq.equilibrium, rq.dense);
   sim.finish(RunStatus::interrupted(0));
   return lin;
 }

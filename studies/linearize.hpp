@@ -6,15 +6,20 @@
 // M = ∂r/∂q̈ (exact: r is linear in q̈), D = ∂r/∂q̇ (sde and drive damping, the PD laws' kd,
 // gyroscopic terms about a moving state), K = ∂r/∂q (elastic with its geometric term, gravity,
 // centrifugal, the PD laws' kp), by central differences of the residual the integrators solve —
-// the same equations, laws included, whatever terms they hold. Outputs y: every link's tip
-// deflection, every joint's coordinate, rate and torque (applied or required), the case's sensors
-// (exact, no noise). First order with x = (δq, δq̇): ẋ = A x + B u, y = C x + D u.
+// the same equations, laws included, whatever terms they hold: sparse, from O(1) evaluations of it
+// (studies/linear_jacobian.hpp), checked against its directional differences; or column by column
+// (`dense`, O(n) evaluations: the reference). Outputs y: every link's tip deflection, every joint's
+// coordinate, rate and torque (applied or required), the case's sensors (exact, no noise). First
+// order with x = (δq, δq̇): ẋ = A x + B u, y = C x + D u (dense: moderate sizes only).
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rfem/core/model.hpp"
 #include "rfem/solvers/equations.hpp"
+#include "rfem/solvers/reduction.hpp"
+#include "rfem/studies/linear_jacobian.hpp"
 
 namespace rfem {
 
@@ -27,15 +32,23 @@ struct LinearModel {
   std::vector<std::string> inputs;   ///< free joints: a torque [N m] (or force [N]) added to each
   std::vector<std::string> outputs;  ///< "LINK/tip_u1", "JOINT/q", "JOINT/tau", sensor columns
   std::vector<std::string> output_units;
-  MatX M, D, K, B, Cq, Cv, Ca;
+  SparseMat M, D, K, B;  ///< states × states (B: × inputs)
+  MatX Cq, Cv, Ca;       ///< outputs × states
   VecX q0, v0, a0;  ///< the operating point (unknowns)
   VecX u0;          ///< the inputs' values there: the residual at the free joints (what holds it)
   VecX y0;          ///< the outputs there
   /// max |r| over the rfe rows at the operating point, relative to the largest elastic or inertial
   /// force term of a column of K or M (≪ 1 at an equilibrium or on the equations' own motion).
   double imbalance = 0.0;
-  /// ẋ = A x + Bs u, y = C x + Ds u with x = (δq, δq̇) (dense; M solved by Cholesky).
+  /// ẋ = A x + Bs u, y = C x + Ds u with x = (δq, δq̇) (dense, M solved by sparse Cholesky);
+  /// std::invalid_argument above kMaxDenseStates states (the descriptor form E ẋ = A x + B u,
+  /// E = [I 0; 0 M], A = [0 I; −K −D], B = [0; B], is sparse: docs/formulation.md §8).
   void state_space(MatX& A, MatX& Bs, MatX& C, MatX& Ds) const;
+  /// A 2N × 2N dense A of 3 000 states takes 288 MB.
+  static constexpr int kMaxDenseStates = 3000;
+  /// Files hold the dense first-order model up to this many states (A: 32 MB), M, D, K, B always.
+  static constexpr int kFileDenseStates = 1000;
+  int evaluations = 0;  ///< of the equations (the sparse method: independent of n)
   /// The first-order states' names: states, then "d/dt NAME".
   std::vector<std::string> first_order_states() const;
 };
@@ -43,13 +56,31 @@ struct LinearModel {
 /// What a linearisation evaluates: the residual r_u and the outputs at (q_u, q̇_u, q̈_u).
 using LinearEvaluation = std::function<void(const VecX& qu, const VecX& vu, const VecX& au, VecX& r, VecX& y)>;
 
-/// Central differences of `f` about (q0, v0, a0) (steps: 1e-6 in q, q̇; q̈ exact). `free_rows`:
-/// the unknown rows of the free joints (the inputs' columns of B).
+/// Column by column: central differences of `f` about (q0, v0, a0) (kLinearizationStep in q, q̇,
+/// Richardson; q̈ exact). `free_rows`: the unknown rows of the free joints (the inputs' columns of B).
 void linearize_about(const LinearEvaluation& f, const VecX& q0, const VecX& v0, const VecX& a0,
                      const std::vector<int>& free_rows, int rfe_rows, LinearModel& lin);
 
-/// Writes `lin` into `file` (group "linear": M, D, K, B, Cq, Cv, Ca, A, Bs, C, Ds as tables with
-/// their row and column names, the operating point, attributes t and equilibrium).
+/// B (the free rows' unit columns), u0 = r0 there, q0, v0, a0, y0 and the imbalance of `lin`,
+/// whose M, D, K are set.
+void set_operating_point(LinearModel& lin, const VecX& q0, const VecX& v0, const VecX& a0, const VecX& r0, const VecX& y0,
+                         const std::vector<int>& free_rows, int rfe_rows);
+
+/// Largest difference between J w and `dJw`, the directional difference of the equations along w
+/// (what a missed entry shows; its row into `row`), row by row relative to (|J| |w|)_i + 1e-9 of
+/// the largest + 1e6 noise_i: a mismatch above 1e-6 is more than 1e-6 of the row's terms plus the
+/// difference's round-off noise_i.
+double directional_mismatch(const SparseMat& J, const VecX& w, const VecX& dJw, const VecX& noise,
+                            Eigen::Index* row = nullptr);
+
+/// The first-order model's lowest `count` modes (frequency [Hz], damping ratio), one per
+/// oscillating pair of eigenvalues of A: dense up to 16 states, else shift-invert
+/// Arnoldi (Spectra) on the sparse pencil K + σD + σ²M.
+std::vector<std::pair<double, double>> linear_modes(const LinearModel& lin, int count);
+
+/// Writes `lin` into `file` (group "linear": M, D, K, B sparse as (row, column, value) tables, 0-based,
+/// with attributes rows and matrix_columns; Cq, Cv, Ca and, up to kFileDenseStates states, A, Bs, C,
+/// Ds as tables with their row and column names; the operating point, attributes t and equilibrium).
 void write_linear(ResultsWriter& file, const LinearModel& lin);
 
 }  // namespace rfem

@@ -114,8 +114,10 @@ class Simulation {
   SimulationState state() const;
   /// The linear model about the state now (studies/linearize.hpp), the laws in force included: at
   /// rest (`equilibrium`: q̈ = 0, the free joints' inputs u0 those that hold it) or on the motion
-  /// (q̈ the state's own).
-  LinearModel linearize(bool equilibrium = true);
+  /// (q̈ the state's own). Sparse from O(1) evaluations of the equations whatever n (checked
+  /// against their directional differences; std::runtime_error if they disagree), or `dense`:
+  /// column by column (9 evaluations per state: the reference).
+  LinearModel linearize(bool equilibrium = true, bool dense = false);
   /// Ends the run with `status` (default: how advance() left it — completed if at t_end, else
   /// interrupted (stopped)), closes the results file and returns the run's record (again on later
   /// calls). Afterwards only the getters work (the rest throws std::logic_error).
@@ -169,6 +171,7 @@ struct LinearizeRequest {
   /// equilibrium, simulation.initial = "static") at t = 0.
   std::shared_ptr<const SimulationState> state;
   bool equilibrium = true;  ///< q̈ = 0 (at rest) or the state's own accelerations
+  bool dense = false;       ///< column by column (the reference) instead of the sparse method
 };
 /// The case's linear model. CaseError for a case that cannot run (check_runnable, integrator "bdf":
 /// linearised with the ESDIRK equations — the same equations), std::invalid_argument for another

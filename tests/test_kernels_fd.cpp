@@ -13,6 +13,7 @@
 #include "rfem/core/positions.hpp"
 #include "rfem/core/rotation.hpp"
 #include "rfem/solvers/statics.hpp"
+#include "rfem/studies/linear_jacobian.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;
@@ -361,5 +362,81 @@ TEST(KernelsFD, PointMotionIsTheTimeDerivativeOfThePointsPosition) {
       EXPECT_LT((pm.acceleration - acc).norm(), 1e-4 * (1.0 + acc.norm())) << "link " << l << " s " << s;
       EXPECT_LT((pm.angular_velocity - w).norm(), 1e-6 * (1.0 + w.norm())) << "link " << l << " s " << s;
     }
+  }
+}
+
+// The linear models' sparse Jacobian (studies/linear_jacobian.hpp: rfes three apart differenced
+// together, the nodes' rows split per rfe through its moments) against differencing the residual
+// column by column, on the tree of every kind of mounting (4 carrying rfes, a prismatic joint, a
+// branch, gravity, sde damping) at a random state, two joints prescribed and two under PD laws:
+// the same differences of the same residual summed in other chunks, so equal to the differences'
+// round-off (~1e-16 of a term over h = 1e-5, relative to the largest entry: 1e-11; 1e-9 allowed),
+// the joints' torques (required, or the PD laws') alike.
+TEST(LinearJacobian, EqualsTheColumnByColumnDifferencesOnATree) {
+  const Model model = test::tree_arm(2, 0.01);
+  VecX q, v, a;
+  test::random_state(model, 7, q, v, a);
+  std::vector<JointInput> in(static_cast<size_t>(model.m()));
+  for (int j = 0; j < model.m(); ++j) {
+    const double q0 = q[model.joint_index(j)];
+    if (j % 2 == 0) {
+      in[static_cast<size_t>(j)].motion = constant_rate_law(q0, 0.3);
+    } else {
+      in[static_cast<size_t>(j)].torque = pd_law(constant_rate_law(q0 + 0.01, 0.1), 40.0, 3.0, nullptr);
+      in[static_cast<size_t>(j)].q0 = q0;
+    }
+  }
+  const double t = 0.2;
+  const EquationsJacobian J = equations_jacobian(model, in, ForceTerms{}, t, q, v, a);
+  std::vector<int> ucoord;
+  for (int i = 0; i < model.flexible_dofs(); ++i) ucoord.push_back(i);
+  for (int j = 0; j < model.m(); ++j)
+    if (j % 2 == 1) ucoord.push_back(model.joint_index(j));
+  const int U = static_cast<int>(ucoord.size());
+  ASSERT_EQ(J.K.rows(), U);
+  auto residual = [&](const VecX& qq, const VecX& vv, const VecX& aa, VecX& r, VecX& tau) {
+    VecX F;
+    generalised_forces(model, qq, vv, aa, ForceTerms{}, F);
+    tau.resize(model.m());
+    for (int j = 0; j < model.m(); ++j) {
+      const int c = model.joint_index(j);
+      tau[j] = in[static_cast<size_t>(j)].prescribed() ? F[c] : in[static_cast<size_t>(j)].torque->at(t, qq[c], vv[c]);
+    }
+    r.resize(U);
+    for (int i = 0; i < U; ++i) r[i] = F[ucoord[static_cast<size_t>(i)]];
+    for (int j = 0, i = model.flexible_dofs(); j < model.m(); ++j)
+      if (j % 2 == 1) r[i++] -= tau[j];
+  };
+  const double h = kLinearizationStep;
+  const SparseMat* mats[3] = {&J.K, &J.D, &J.M};
+  const MatX* taus[3] = {&J.tau_q, &J.tau_v, &J.tau_a};
+  for (int kind = 0; kind < 3; ++kind) {
+    const MatX Js(*mats[kind]);
+    const double scale = Js.cwiseAbs().maxCoeff(), tscale = taus[kind]->cwiseAbs().maxCoeff();
+    double worst = 0.0, tworst = 0.0;
+    for (int c = 0; c < U; ++c) {
+      VecX x[3] = {q, v, a}, r1, r2, r3, r4, t1, t2, t3, t4;
+      const int k = ucoord[static_cast<size_t>(c)];
+      auto at = [&](double d, VecX& r, VecX& tau) {
+        VecX y[3] = {q, v, a};
+        y[kind][k] += d;
+        residual(y[0], y[1], y[2], r, tau);
+      };
+      VecX col, tcol;
+      if (kind < 2) {
+        at(h, r1, t1), at(-h, r2, t2), at(2 * h, r3, t3), at(-2 * h, r4, t4);
+        col = (8 * (r1 - r2) - (r3 - r4)) / (12 * h);
+        tcol = (8 * (t1 - t2) - (t3 - t4)) / (12 * h);
+      } else {
+        at(1.0, r1, t1), at(0.0, r2, t2);
+        col = r1 - r2;
+        tcol = t1 - t2;
+      }
+      worst = std::max(worst, (Js.col(c) - col).cwiseAbs().maxCoeff());
+      tworst = std::max(tworst, (taus[kind]->col(c) - tcol).cwiseAbs().maxCoeff());
+    }
+    EXPECT_GT(scale, 0.0) << kind;
+    EXPECT_LE(worst, 1e-9 * scale) << "matrix " << kind << " (K, D, M)";
+    EXPECT_LE(tworst, 1e-9 * std::max(tscale, 1e-300)) << "torques " << kind;
   }
 }

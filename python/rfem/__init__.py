@@ -372,7 +372,7 @@ def __dir__():
     return sorted(set(globals()) | {"plots", "animate", "linear"})
 
 
-def linearize(case, n=None, state=None, threads=1, equilibrium=True, output=None):
+def linearize(case, n=None, state=None, threads=1, equilibrium=True, output=None, dense=False):
     """The case's linear model (an rfem.LinearModel) about its initial state — the static equilibrium
     of simulation.initial = "static" at t = 0 — or about `state` (an rfem.SimulationState: the same
     model, its time), at rest (equilibrium=True: accelerations zero, u0 the torques that hold it) or on
@@ -383,10 +383,14 @@ def linearize(case, n=None, state=None, threads=1, equilibrium=True, output=None
     over the unknowns (`states`: rfe coordinates and free joints; prescribed joints held on their
     motion, their torque an output), inputs u a torque added at each free joint, outputs every link's
     tip deflection, every joint's q, v, tau and the case's sensors. By central differences of the
-    equations the integrators solve (the case's laws, PD gains included). lin.state_space() gives
-    (A, B, C, D) for x = (q, q'). `output`: an HDF5 file (group "linear": every matrix with its row
-    and column names; MATLAB's h5read, h5py, SciPy read it), as `rfem linearize -o`."""
-    return _rfem._linearize(case, n, state, threads, equilibrium, output, "rfem.linearize (Python)")
+    equations the integrators solve (the case's laws, PD gains included): M, D, K, B sparse
+    (scipy.sparse) from O(1) evaluations whatever n, checked against the equations' directional
+    differences; dense=True differences them column by column (the reference, O(n²)).
+    lin.state_space() gives (A, B, C, D) for x = (q, q') (dense, up to 3000 states), lin.modes() the
+    lowest modes. `output`: an HDF5 file (group "linear": every matrix with its row and column names,
+    M, D, K, B as (row, column, value) tables; MATLAB's h5read, h5py, SciPy read it), as
+    `rfem linearize -o`."""
+    return _rfem._linearize(case, n, state, threads, equilibrium, output, "rfem.linearize (Python)", dense)
 
 
 def _frequency_response(self, frequencies, input=None, output=None):

@@ -3,7 +3,7 @@ and Bode plots, from a model in memory or its file. `rfem bode` is `python3 -m r
 
     G(j2πf) = (Cq + jω Cv − ω² Ca) (K + jω D − ω² M)⁻¹ B        (docs/formulation.md §8)
 
-one N×N complex solve per frequency (the second-order form; no 2N first-order system)."""
+one sparse N×N complex solve per frequency (the second-order form; no 2N first-order system)."""
 import argparse
 import os
 import sys
@@ -28,14 +28,23 @@ class LinearFile:
                 if "linear" not in f:
                     raise LinearError(f"{self.path}: no linear model (group linear; write one with rfem linearize -o)")
                 g = f["linear"]
-                for name in ("M", "D", "K", "Cq", "Cv", "Ca"):
-                    setattr(self, name, g[name][()])
                 text = lambda v: [x.decode() if isinstance(x, bytes) else str(x) for x in v]  # noqa: E731
                 self.states = text(g.attrs["states"])
                 self.inputs = [] if text(g.attrs["inputs"]) == ["(none)"] else text(g.attrs["inputs"])
                 self.outputs = text(g.attrs["outputs"])
                 self.output_units = text(g.attrs["output_units"])
-                self.B = g["B"][()] if "B" in g else np.zeros((len(self.states), 0))
+                for name in ("M", "D", "K", "B", "Cq", "Cv", "Ca"):
+                    if name == "B" and "B" not in g:  # (every joint prescribed: no inputs)
+                        setattr(self, name, _sparse(np.zeros((len(self.states), 0))))
+                        continue
+                    d = g[name]
+                    if "matrix_columns" in d.attrs:  # sparse: (row, column, value), 0-based
+                        import scipy.sparse as sp
+                        t = d[()]
+                        shape = (len(d.attrs["rows"]), len(d.attrs["matrix_columns"]))
+                        setattr(self, name, sp.csc_matrix((t[:, 2], (t[:, 0].astype(int), t[:, 1].astype(int))), shape=shape))
+                    else:  # a table (older files held M, D, K, B as tables too)
+                        setattr(self, name, _sparse(d[()]) if name in ("M", "D", "K", "B") else d[()])
                 about = g.attrs["about"]
                 self.equilibrium = (about.decode() if isinstance(about, bytes) else str(about)) == "equilibrium"
                 t = g.attrs["t"]
@@ -46,6 +55,11 @@ class LinearFile:
     def __repr__(self):
         return (f"<rfem.linear.LinearFile {self.path}: {len(self.states)} states, {len(self.inputs)} inputs, "
                 f"{len(self.outputs)} outputs>")
+
+
+def _sparse(a):
+    import scipy.sparse as sp
+    return sp.csc_matrix(a)
 
 
 def _model(lin):
@@ -72,27 +86,51 @@ def frequency_response(lin, frequencies, input=None, output=None):
         raise LinearError("frequencies: must be finite and 0 or more [Hz]")
     ins = slice(None) if input is None else [_index(lin.inputs, input, "input")]
     outs = slice(None) if output is None else [_index(lin.outputs, output, "output")]
-    M, D, K, B = lin.M, lin.D, lin.K, lin.B[:, ins]
+    import scipy.sparse.linalg as sla
+    M, D, K = (_sparse(x) for x in (lin.M, lin.D, lin.K))
+    B = _sparse(lin.B)[:, ins].toarray()
     Cq, Cv, Ca = lin.Cq[outs], lin.Cv[outs], lin.Ca[outs]
     G = np.empty((len(f), Cq.shape[0], B.shape[1]), dtype=complex)
     for k, fk in enumerate(f):
         w = 2 * np.pi * fk
-        X = np.linalg.solve(K + 1j * w * D - w * w * M, B)
+        X = sla.splu((K + 1j * w * D - w * w * M).astype(complex).tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.01,
+                     options=dict(SymmetricMode=True)).solve(B.astype(complex))
         G[k] = (Cq + 1j * w * Cv - w * w * Ca) @ X
     return G[:, 0, 0] if input is not None and output is not None else G
 
 
-def modes(lin):
+def modes(lin, count=None):
     """The first-order model's modes: (frequencies [Hz], damping ratios), ascending, one per
-    oscillating pair (eigenvalues of A with ω > 0)."""
+    oscillating pair (eigenvalues of A with ω > 0): every one up to 16 states (dense), else the
+    lowest `count` (default 12) by shift-invert Arnoldi on the sparse pencil K + σD + σ²M, as
+    `rfem linearize` prints them (dense QR loses the lowest ones' digits to ‖A‖ ~ the highest ω²)."""
     lin = _model(lin)
-    N = lin.M.shape[0]
-    MK, MD = np.linalg.solve(lin.M, lin.K), np.linalg.solve(lin.M, lin.D)
-    A = np.block([[np.zeros((N, N)), np.eye(N)], [-MK, -MD]])
-    ev = np.linalg.eigvals(A)
+    M, D, K = (_sparse(x) for x in (lin.M, lin.D, lin.K))
+    N = M.shape[0]
+    if N <= 16:
+        MK = np.linalg.solve(M.toarray(), K.toarray())
+        MD = np.linalg.solve(M.toarray(), D.toarray())
+        A = np.block([[np.zeros((N, N)), np.eye(N)], [-MK, -MD]])
+        ev = np.linalg.eigvals(A)
+    else:
+        import scipy.sparse.linalg as sla
+        count = 12 if count is None else count
+        s = -0.1  # (A − sI)⁻¹ [x1; x2] = [y1; x1 + s y1], (K + sD + s²M) y1 = −M x2 − (D + sM) x1
+        # (the states' own order: chains of rfes, then their border — no fill; COLAMD's order fills)
+        lu = sla.splu((K + s * D + s * s * M).tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.01,
+                      options=dict(SymmetricMode=True))
+
+        def op(x):
+            x1, x2 = x[:N], x[N:]
+            y1 = lu.solve(-(M @ x2) - D @ x1 - s * (M @ x1))
+            return np.concatenate([y1, x1 + s * y1])
+        k = min(2 * count + 6, 2 * N - 3)
+        mu = sla.eigs(sla.LinearOperator((2 * N, 2 * N), matvec=op), k=k, which="LM", tol=1e-12, return_eigenvectors=False)
+        ev = s + 1 / mu
     ev = ev[ev.imag > 0]
-    order = np.argsort(np.abs(ev))
-    ev = ev[order]
+    ev = ev[np.argsort(np.abs(ev))]
+    if count is not None:
+        ev = ev[:count]
     return np.abs(ev) / (2 * np.pi), -ev.real / np.abs(ev)
 
 

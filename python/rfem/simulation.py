@@ -102,11 +102,11 @@ class Simulation:
         """The state now (rfem.SimulationState): rfem.Simulation(case, state=...) goes on from it."""
         return self._sim.state()
 
-    def linearize(self, equilibrium=True):
+    def linearize(self, equilibrium=True, dense=False):
         """The linear model about the state now (rfem.LinearModel), the laws in force included: at rest
         (equilibrium=True: accelerations zero, u0 the free joints' torques that hold it) or on the
-        motion (the state's own accelerations)."""
-        return self._sim.linearize(equilibrium)
+        motion (the state's own accelerations). Sparse (dense=True: column by column, the reference)."""
+        return self._sim.linearize(equilibrium, dense)
 
     def finish(self):
         """Ends the run (completed at t_end, else "interrupted (stopped)"), closes the file, returns the Run."""
