@@ -233,6 +233,15 @@ void bind_simulation(py::module_& m) {
         }
         return py::make_tuple(A, B, C, D);
       }, "(A, B, C, D) of x' = A x + B u, y = C x + D u with x = (q, q'): 2N states, dense (up to 3000 states)")
+      .def("descriptor", [](const LinearModel& l) {
+        SparseMat E, A, B, C;
+        {
+          py::gil_scoped_release release;
+          l.descriptor(E, A, B, C);
+        }
+        return py::make_tuple(E, A, B, C);
+      }, "(E, A, B, C), scipy.sparse, of E x' = A x + B u, y = C x with x = (q, q', q''): 3N states, any size "
+         "(E = diag(I, I, 0): the last block row is the equations of motion)")
       .def("modes", [](const LinearModel& l, int count) {
         std::vector<std::pair<double, double>> m;
         {

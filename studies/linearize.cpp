@@ -125,6 +125,32 @@ std::vector<std::string> LinearModel::first_order_states() const {
   return x;
 }
 
+void LinearModel::descriptor(SparseMat& E, SparseMat& A, SparseMat& Bd, SparseMat& C) const {
+  const Eigen::Index N = M.rows(), P = Cq.rows(), m = B.cols();
+  std::vector<Eigen::Triplet<double>> e, a, b, c;
+  for (Eigen::Index i = 0; i < 2 * N; ++i) e.emplace_back(i, i, 1.0);
+  for (Eigen::Index i = 0; i < 2 * N; ++i) a.emplace_back(i, N + i, 1.0);  // q' = v, v' = a
+  const SparseMat* blocks[3] = {&K, &D, &M};
+  for (int k = 0; k < 3; ++k)
+    for (Eigen::Index col = 0; col < N; ++col)
+      for (SparseMat::InnerIterator it(*blocks[k], col); it; ++it) a.emplace_back(2 * N + it.row(), k * N + col, -it.value());
+  for (Eigen::Index col = 0; col < m; ++col)
+    for (SparseMat::InnerIterator it(B, col); it; ++it) b.emplace_back(2 * N + it.row(), col, it.value());
+  const MatX* outs[3] = {&Cq, &Cv, &Ca};
+  for (int k = 0; k < 3; ++k)
+    for (Eigen::Index i = 0; i < P; ++i)
+      for (Eigen::Index j = 0; j < N; ++j)
+        if ((*outs[k])(i, j) != 0.0) c.emplace_back(i, k * N + j, (*outs[k])(i, j));
+  E.resize(3 * N, 3 * N);
+  E.setFromTriplets(e.begin(), e.end());
+  A.resize(3 * N, 3 * N);
+  A.setFromTriplets(a.begin(), a.end());
+  Bd.resize(3 * N, m);
+  Bd.setFromTriplets(b.begin(), b.end());
+  C.resize(P, 3 * N);
+  C.setFromTriplets(c.begin(), c.end());
+}
+
 void LinearModel::state_space(MatX& A, MatX& Bs, MatX& C, MatX& Ds) const {
   const Eigen::Index N = M.rows();
   if (N > kMaxDenseStates)

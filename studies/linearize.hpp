@@ -41,9 +41,13 @@ struct LinearModel {
   /// force term of a column of K or M (≪ 1 at an equilibrium or on the equations' own motion).
   double imbalance = 0.0;
   /// ẋ = A x + Bs u, y = C x + Ds u with x = (δq, δq̇) (dense, M solved by sparse Cholesky);
-  /// std::invalid_argument above kMaxDenseStates states (the descriptor form E ẋ = A x + B u,
-  /// E = [I 0; 0 M], A = [0 I; −K −D], B = [0; B], is sparse: docs/formulation.md §8).
+  /// std::invalid_argument above kMaxDenseStates states (descriptor() is sparse).
   void state_space(MatX& A, MatX& Bs, MatX& C, MatX& Ds) const;
+  /// The same model as a sparse descriptor system of any size, x = (δq, δq̇, δq̈) (3N states):
+  ///   E ẋ = A x + B u,  y = C x,   E = [I 0 0; 0 I 0; 0 0 0],  A = [0 I 0; 0 0 I; −K −D −M],
+  ///   B = [0; 0; B],  C = [Cq Cv Ca]
+  /// (the last block row the equations of motion, algebraic: index 1, as M is invertible).
+  void descriptor(SparseMat& E, SparseMat& A, SparseMat& Bd, SparseMat& C) const;
   /// A 2N × 2N dense A of 3 000 states takes 288 MB.
   static constexpr int kMaxDenseStates = 3000;
   /// Files hold the dense first-order model up to this many states (A: 32 MB), M, D, K, B always.
