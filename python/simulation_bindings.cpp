@@ -256,6 +256,14 @@ void bind_simulation(py::module_& m) {
                std::to_string(l.outputs.size()) + " outputs, about " + (l.equilibrium ? "rest" : "the motion") + " at t = " +
                py::repr(py::float_(l.t)).cast<std::string>() + " s>";
       });
+  m.def("_linear_modes", [](const SparseMat& M, const SparseMat& D, const SparseMat& K, int count) {
+    LinearModel l;  // (the modes need M, D and K only)
+    l.M = M;
+    l.D = D;
+    l.K = K;
+    py::gil_scoped_release release;
+    return linear_modes(l, count);
+  }, py::arg("M"), py::arg("D"), py::arg("K"), py::arg("count"));
   m.def("_linearize", [](py::handle case_arg, py::handle n, py::handle state, py::handle threads, py::handle equilibrium,
                          py::handle output_arg, const std::string& made_by, py::handle dense) {
     const args::CaseArg cs_arg(case_arg);

@@ -10,12 +10,8 @@ namespace rfem {
 
 namespace {
 
-// A difference quotient: Σ_s w_s (f(x + d_s e) − f(x)).
-using Difference = std::vector<std::pair<double, double>>;  // (d_s, w_s)
-
-Difference central(double h) {  // at h and 2h, extrapolated (Richardson): truncation O(h⁴)
-  return {{h, 8 / (12 * h)}, {-h, -8 / (12 * h)}, {2 * h, -1 / (12 * h)}, {-2 * h, 1 / (12 * h)}};
-}
+// A difference quotient: Σ_s w_s (f(x + d_s e) − f(x)), as (d_s, w_s).
+using Difference = std::vector<std::pair<double, double>>;
 
 // The part of an rfe's moments its node rows read (generalised_forces sets no Y or G for rfes).
 struct Wrench {
@@ -61,7 +57,6 @@ class Evaluator {
 
   const VecX& dF() const { return dF_; }
   const VecX& dtau() const { return dtau_; }
-  const VecX& F0() const { return F0_; }
   const VecX& tau0() const { return tau0_; }
   const Wrench& dmom(int chunk) const { return dmom_[static_cast<size_t>(chunk)]; }
   const BaseKinematics& bk0() const { return bk0_; }
@@ -135,14 +130,12 @@ EquationsJacobian equations_jacobian(const Model& model, const std::vector<Joint
   }
 
   EquationsJacobian J;
-  J.r0.resize(U);
-  for (int i = 0; i < U; ++i) {
-    const int j = free_joint_of_row[static_cast<size_t>(i)];
-    J.r0[i] = ev.F0()[ucoord[static_cast<size_t>(i)]] - (j >= 0 ? ev.tau0()[j] : 0.0);
-  }
   J.tau0 = ev.tau0();
+  J.coords = ucoord;
+  const auto rich = richardson();
+  const Difference central(rich.begin(), rich.end());
   const Difference unit = {{1.0, 1.0}};  // r is linear in q̈: one unit step, exact up to round-off
-  const Difference diffs[3] = {central(kLinearizationStep), central(kLinearizationStep), unit};
+  const Difference diffs[3] = {central, central, unit};
   SparseMat* mats[3] = {&J.K, &J.D, &J.M};
   MatX* taus[3] = {&J.tau_q, &J.tau_v, &J.tau_a};
   VecX node_rows = VecX::Zero(model.dof());

@@ -14,6 +14,8 @@
 //     one at a time.
 // Differences as the dense linearisation (central at h and 2h, Richardson; q̈ exact, one unit step).
 // The caller checks the result against directional differences of its own residual.
+#include <array>
+#include <utility>
 #include <vector>
 
 #include "rfem/assembly/assemble.hpp"
@@ -29,10 +31,36 @@ namespace rfem {
 /// 1e-4 measured alike, 1e-3 3e-10 from truncation).
 constexpr double kLinearizationStep = 1e-5;
 
+/// Richardson's extrapolation of central differences at h and 2h (truncation O(h⁴)) as offsets and
+/// weights: f' ≈ Σ_s w_s f(x + d_s) = (8 (f(h) − f(−h)) − (f(2h) − f(−2h))) / 12h.
+inline std::array<std::pair<double, double>, 4> richardson(double h = kLinearizationStep) {
+  return {{{h, 8 / (12 * h)}, {-h, -8 / (12 * h)}, {2 * h, -1 / (12 * h)}, {-2 * h, 1 / (12 * h)}}};
+}
+
+/// Σ_s w_s a(d_s) for Richardson's offsets: the derivative of two vectors `at(d, a, b)` evaluates
+/// at offset d (into da, db).
+template <class At>
+void richardson_difference(At&& at, VecX& da, VecX& db, double h = kLinearizationStep) {
+  VecX a, b;
+  bool first = true;
+  for (const auto& [d, w] : richardson(h)) {
+    at(d, a, b);
+    if (first) {
+      da = w * a;
+      db = w * b;
+      first = false;
+    } else {
+      da += w * a;
+      db += w * b;
+    }
+  }
+}
+
 struct EquationsJacobian {
   SparseMat K, D, M;       ///< ∂r/∂q, ∂r/∂q̇, ∂r/∂q̈: unknown rows × unknown columns (full unknowns)
   MatX tau_q, tau_v, tau_a;  ///< every joint's torque (required, or its law's) × the same columns
-  VecX r0, tau0;           ///< the residual and the torques at the point
+  VecX tau0;               ///< the torques at the point
+  std::vector<int> coords; ///< each full unknown's coordinate in the model
   int evaluations = 0;     ///< of the generalised forces
 };
 

@@ -65,6 +65,19 @@ using LinearEvaluation = std::function<void(const VecX& qu, const VecX& vu, cons
 void linearize_about(const LinearEvaluation& f, const VecX& q0, const VecX& v0, const VecX& a0,
                      const std::vector<int>& free_rows, int rfe_rows, LinearModel& lin);
 
+/// The outputs at full coordinates q, v, a and every joint's torque.
+using OutputEvaluation = std::function<void(const VecX& q, const VecX& v, const VecX& a, const VecX& tau, VecX& y)>;
+
+/// Sparse (studies/linear_jacobian.hpp): the Jacobians of `eq`'s equations at time t about the
+/// unknowns' (q0, v0, a0), over the full unknowns and projected on reduced links (K = Pᵀ K_full P);
+/// the outputs `g` differenced column by column (no equations), τ's part through the torque rows.
+/// Then checked against directional differences of `f` (eq's residual and g) along one direction
+/// touching every unknown: std::runtime_error naming the row or output if a row disagrees by more
+/// than 1e-6 of its terms plus round-off. lin's states and outputs must be set.
+void linearize_sparse(EquationsOfMotion& eq, double t, const LinearEvaluation& f, const OutputEvaluation& g,
+                      const VecX& q0, const VecX& v0, const VecX& a0, const std::vector<int>& free_rows, int rfe_rows,
+                      LinearModel& lin);
+
 /// B (the free rows' unit columns), u0 = r0 there, q0, v0, a0, y0 and the imbalance of `lin`,
 /// whose M, D, K are set.
 void set_operating_point(LinearModel& lin, const VecX& q0, const VecX& v0, const VecX& a0, const VecX& r0, const VecX& y0,

@@ -1,7 +1,6 @@
 #include "rfem/studies/simulation.hpp"
 
 #include <cmath>
-#include <limits>
 #include <deque>
 #include <stdexcept>
 
@@ -456,7 +455,7 @@ LinearModel Simulation::linearize(bool equilibrium, bool dense) {
   }
   // The outputs at full coordinates and joint torques.
   std::vector<double> out;
-  auto outputs = [&](const VecX& q, const VecX& v, const VecX& a, const VecX& tau, VecX& y) {
+  const OutputEvaluation outputs = [&](const VecX& q, const VecX& v, const VecX& a, const VecX& tau, VecX& y) {
     out.clear();
     for (size_t l = 0; l < md.links.size(); ++l) {
       const Vec3 d = tip_deflection(md, static_cast<int>(l), q);
@@ -475,103 +474,8 @@ LinearModel Simulation::linearize(bool equilibrium, bool dense) {
   };
   const VecX a0 = equilibrium ? VecX::Zero(N) : x.a;
   const int rfe_rows = N - static_cast<int>(free_rows.size());
-  if (dense) {
-    linearize_about(f, x.q, x.v, a0, free_rows, rfe_rows, lin);
-    return lin;
-  }
-  // Sparse, over the full unknowns (every rfe coordinate, the free joints), then projected on the
-  // reduced ones: K = Pᵀ K_full P (r_η = Φᵀ r at q0 + P x), outputs C_full P.
-  const VecX qf = eq.full_coordinates(x.t, x.q.data(), 0), vf = eq.full_coordinates(x.t, x.v.data(), 1),
-             af = eq.full_coordinates(x.t, a0.data(), 2);
-  const EquationsJacobian J = equations_jacobian(md, eq.inputs(), eq.terms(), x.t, qf, vf, af);
-  const int U = static_cast<int>(J.K.rows()), n6 = md.flexible_dofs();
-  const Reduction* red = eq.reduction().get();
-  const SparseMat P = red ? red->projector(U - n6) : SparseMat();
-  auto reduce = [&](const SparseMat& S) { return red ? SparseMat(SparseMat(P.transpose()) * S * P) : S; };
-  lin.K = reduce(J.K);
-  lin.D = reduce(J.D);
-  lin.M = reduce(J.M);
-  // Outputs: y(q, v, a, τ) column by column (cheap: no equations), τ's part through the torques' rows.
-  std::vector<int> ucoord;  // each full unknown's coordinate
-  for (int i = 0; i < n6; ++i) ucoord.push_back(i);
-  for (int j = 0; j < md.m(); ++j)
-    if (!eq.inputs()[j].prescribed()) ucoord.push_back(md.joint_index(j));
-  VecX y0, yp, ym, y2p, y2m;
-  outputs(qf, vf, af, J.tau0, y0);
-  const Eigen::Index Pn = y0.size();
-  const double h = kLinearizationStep;
-  auto slope = [&](VecX& x_, Eigen::Index i, auto&& eval) {  // Richardson's central difference of y in x_[i]
-    const double x0 = x_[i];
-    x_[i] = x0 + h, eval(yp);
-    x_[i] = x0 - h, eval(ym);
-    x_[i] = x0 + 2 * h, eval(y2p);
-    x_[i] = x0 - 2 * h, eval(y2m);
-    x_[i] = x0;
-    return VecX((8 * (yp - ym) - (y2p - y2m)) / (12 * h));
-  };
-  VecX qw = qf, vw = vf, aw = af, tw = J.tau0;
-  MatX dy_dtau(Pn, md.m());
-  for (int j = 0; j < md.m(); ++j) dy_dtau.col(j) = slope(tw, j, [&](VecX& y) { outputs(qw, vw, aw, tw, y); });
-  MatX Cq(Pn, U), Cv(Pn, U), Ca(Pn, U);
-  for (int c = 0; c < U; ++c) {
-    const int k = ucoord[static_cast<size_t>(c)];
-    Cq.col(c) = slope(qw, k, [&](VecX& y) { outputs(qw, vw, aw, tw, y); });
-    Cv.col(c) = slope(vw, k, [&](VecX& y) { outputs(qw, vw, aw, tw, y); });
-    aw[k] += 1.0;  // (linear in q̈)
-    outputs(qw, vw, aw, tw, yp);
-    aw[k] = af[k];
-    Ca.col(c) = yp - y0;
-  }
-  Cq += dy_dtau * J.tau_q;
-  Cv += dy_dtau * J.tau_v;
-  Ca += dy_dtau * J.tau_a;
-  lin.Cq = red ? MatX(Cq * P) : Cq;
-  lin.Cv = red ? MatX(Cv * P) : Cv;
-  lin.Ca = red ? MatX(Ca * P) : Ca;
-  VecX r0, y0u;
-  f(x.q, x.v, a0, r0, y0u);
-  set_operating_point(lin, x.q, x.v, a0, r0, y0u, free_rows, rfe_rows);
-  lin.evaluations = J.evaluations + 1;
-  // The check: directional differences of the equations themselves along a fixed direction that
-  // touches every unknown, of the columns' size (what a wrong sparsity pattern would miss shows as
-  // a row's mismatch).
-  VecX w(N);
-  for (int i = 0; i < N; ++i) w[i] = std::sin(1.0 + 0.7 * i);  // (fixed, smooth: no stream of random numbers)
-  VecX r1, r2, r3, r4, y1, y2, y3, y4;
-  auto along = [&](double s, int kind, VecX& r, VecX& y) {
-    VecX qq = x.q, vv = x.v, aa = a0;
-    (kind == 0 ? qq : kind == 1 ? vv : aa) += s * w;
-    f(qq, vv, aa, r, y);
-  };
-  struct Check { const char* name; const SparseMat* J; const MatX* C; };
-  const Check checks[3] = {{"K", &lin.K, &lin.Cq}, {"D", &lin.D, &lin.Cv}, {"M", &lin.M, &lin.Ca}};
-  for (int kind = 0; kind < 3; ++kind) {
-    VecX dr, dy;
-    if (kind < 2) {
-      along(h, kind, r1, y1), along(-h, kind, r2, y2), along(2 * h, kind, r3, y3), along(-2 * h, kind, r4, y4);
-      dr = (8 * (r1 - r2) - (r3 - r4)) / (12 * h);
-      dy = (8 * (y1 - y2) - (y3 - y4)) / (12 * h);
-    } else {
-      along(1.0, kind, r1, y1);
-      dr = r1 - r0;
-      dy = y1 - y0u;
-    }
-    lin.evaluations += kind < 2 ? 4 : 1;
-    // The differences' round-off: ~1.5 ε |value| / h (Richardson's weights), ten times that.
-    const double unit = 10 * std::numeric_limits<double>::epsilon() / (kind < 2 ? h : 1.0);
-    Eigen::Index row = 0, out_row = 0;
-    const double bad = directional_mismatch(*checks[kind].J, w, dr, unit * r0.cwiseAbs(), &row);
-    const double bad_y = directional_mismatch(checks[kind].C->sparseView(1.0, 0.0), w, dy, unit * y0u.cwiseAbs(), &out_row);
-    // (Measured ≤ 2.5e-8 of a row: the differences' round-off; a missed entry shows at its size.)
-    if (bad > 1e-6 || bad_y > 1e-6) {
-      char buf[96];
-      std::snprintf(buf, sizeof buf, "%.2g", std::max(bad, bad_y));
-      const std::string where = bad >= bad_y ? "row " + lin.states[static_cast<size_t>(row)]
-                                             : "output " + lin.outputs[static_cast<size_t>(out_row)];
-      throw std::runtime_error(std::string("linearize: the sparse ") + checks[kind].name + " differs from the equations' directional difference by " +
-                               buf + " of " + where + "; --dense (Python dense=True) differences them column by column (please report this model)");
-    }
-  }
+  if (dense) linearize_about(f, x.q, x.v, a0, free_rows, rfe_rows, lin);
+  else linearize_sparse(eq, x.t, f, outputs, x.q, x.v, a0, free_rows, rfe_rows, lin);
   return lin;
 }
 

@@ -99,39 +99,16 @@ def frequency_response(lin, frequencies, input=None, output=None):
     return G[:, 0, 0] if input is not None and output is not None else G
 
 
-def modes(lin, count=None):
-    """The first-order model's modes: (frequencies [Hz], damping ratios), ascending, one per
-    oscillating pair (eigenvalues of A with ω > 0): every one up to 16 states (dense), else the
-    lowest `count` (default 12) by shift-invert Arnoldi on the sparse pencil K + σD + σ²M, as
-    `rfem linearize` prints them (dense QR loses the lowest ones' digits to ‖A‖ ~ the highest ω²)."""
+def modes(lin, count=12):
+    """The first-order model's lowest `count` modes: (frequencies [Hz], damping ratios), ascending,
+    one per oscillating pair of eigenvalues of A (ω > 0) — as `rfem linearize` prints them and
+    LinearModel.modes gives them (dense up to 16 states, else shift-invert Arnoldi on the sparse
+    pencil K + σD + σ²M: dense QR loses the lowest ones' digits to ‖A‖ ~ the highest ω²)."""
+    from . import _rfem
     lin = _model(lin)
-    M, D, K = (_sparse(x) for x in (lin.M, lin.D, lin.K))
-    N = M.shape[0]
-    if N <= 16:
-        MK = np.linalg.solve(M.toarray(), K.toarray())
-        MD = np.linalg.solve(M.toarray(), D.toarray())
-        A = np.block([[np.zeros((N, N)), np.eye(N)], [-MK, -MD]])
-        ev = np.linalg.eigvals(A)
-    else:
-        import scipy.sparse.linalg as sla
-        count = 12 if count is None else count
-        s = -0.1  # (A − sI)⁻¹ [x1; x2] = [y1; x1 + s y1], (K + sD + s²M) y1 = −M x2 − (D + sM) x1
-        # (the states' own order: chains of rfes, then their border — no fill; COLAMD's order fills)
-        lu = sla.splu((K + s * D + s * s * M).tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.01,
-                      options=dict(SymmetricMode=True))
-
-        def op(x):
-            x1, x2 = x[:N], x[N:]
-            y1 = lu.solve(-(M @ x2) - D @ x1 - s * (M @ x1))
-            return np.concatenate([y1, x1 + s * y1])
-        k = min(2 * count + 6, 2 * N - 3)
-        mu = sla.eigs(sla.LinearOperator((2 * N, 2 * N), matvec=op), k=k, which="LM", tol=1e-12, return_eigenvectors=False)
-        ev = s + 1 / mu
-    ev = ev[ev.imag > 0]
-    ev = ev[np.argsort(np.abs(ev))]
-    if count is not None:
-        ev = ev[:count]
-    return np.abs(ev) / (2 * np.pi), -ev.real / np.abs(ev)
+    M, D, K = (_sparse(x).astype(float) for x in (lin.M, lin.D, lin.K))
+    m = _rfem._linear_modes(M, D, K, int(count))
+    return np.array([x[0] for x in m]), np.array([x[1] for x in m])
 
 
 def bode(lin, input, output, frequencies=None, fig=None, marks=6):

@@ -290,3 +290,19 @@ def test_the_descriptor_form_answers_as_the_second_order_form():
         G = C @ X
         ref = linear.frequency_response(lin, [f], "elbow")[0][:, 0]
         assert np.abs(G - ref).max() <= 1e-7 * np.abs(ref).max(), (f, np.abs(G - ref).max())
+
+
+def test_a_free_hubs_modes_come_out_of_the_shift_invert_solver():
+    """Kane's beam on a free hub (120 states: shift-invert, not dense): the hub's rigid motion is a
+    double zero of A (a Jordan block Arnoldi converges to only to √ε); the oscillating modes must
+    still come out, equal to `rfem modes --free hub` to the linear model's 1e-8 (the first test),
+    from LinearModel.modes, rfem.linear.modes and the program's print alike."""
+    from rfem import linear
+    free = rfem.load(case_path("kane_spinup.toml"), {"joints.0.input": FREE})
+    lin = rfem.linearize(free, n=20)
+    md = np.asarray(rfem.modes(free, n=20, count=7, free=["hub"]).frequencies)
+    assert md[0] == 0.0  # (the hub's rigid turn)
+    md = md[1:]
+    f = np.array([x[0] for x in lin.modes(6)])
+    assert np.abs(f / md - 1).max() < 1e-8, (f, md)
+    np.testing.assert_array_equal(linear.modes(lin, 6)[0], f)
