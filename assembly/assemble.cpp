@@ -276,10 +276,9 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
   };
   prepare(values);
   for (const auto& x : extra) prepare(*x.values);
-  if (ws.zero.size() != model.dof()) ws.zero = VecX::Zero(model.dof());
-  const VecX& zero = ws.zero;
+  const Vec6 zero6 = Vec6::Zero();  // the rfes' accelerations: none in a matrix
   BaseKinematics& bk = ws.bk;
-  base_kinematics(model, q, v, zero, bk);
+  base_kinematics(model, q, v, bk);
   const double g = t.gravity ? model.gravity : 0.0;
   const bool sdes = t.stiffness != 0.0 || t.damping != 0.0 || ne > 0;
   bool any_damping = t.damping != 0.0;
@@ -325,7 +324,7 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
       if (pattern.width(b) > unknown_ancestors[ch.link])
         std::fill_n(values.data() + pattern.border(b), 6 * pattern.width(b), 0.0);
       for (const auto& x : extra) std::fill_n(x.values->data() + pattern.diag(b), pattern.block_size(b), 0.0);
-      rfe_pose(rfe, fr, q.segment<6>(ik), v.segment<6>(ik), zero.segment<6>(ik), pose, t.inertial, second);
+      rfe_pose(rfe, fr, q.segment<6>(ik), v.segment<6>(ik), zero6, pose, t.inertial, second);
       rfe_mass_blocks(rfe, pose, bk.Xi, anc, Mkk, border, G);
       mom.G += G;
       mom.s += pose.W * rfe.H.col(3);
@@ -416,7 +415,7 @@ void assemble_matrices(const Model& model, const BorderedPattern& pattern, const
         if (!L.carries(k)) continue;
         RfePose pose;
         const int ik = model.rfe_index(li, k);
-        rfe_pose(d.rfes[k], bk.frame[l], q.segment<6>(ik), v.segment<6>(ik), zero.segment<6>(ik), pose, true, true);
+        rfe_pose(d.rfes[k], bk.frame[l], q.segment<6>(ik), v.segment<6>(ik), zero6, pose, true, true);
         const int first[1] = {ik};
         const Mat6 B = t.stiffness * rfe_inertial_stiffness(d.rfes[k], pose, bk.frame[l]);
         scatter_entries<1>(pattern, first, B, values);
@@ -453,9 +452,8 @@ Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* w
   Workspace& ws = wsp ? *wsp : local;
   ws.check(model);
   Energies E;
-  if (ws.zero.size() != model.dof()) ws.zero = VecX::Zero(model.dof());
   BaseKinematics& bk = ws.bk;
-  base_kinematics(model, q, v, ws.zero, bk);
+  base_kinematics(model, q, v, bk);
   for (size_t i = 0; i < model.nodes.size(); ++i) {
     const Node& nd = model.nodes[i];
     E.kinetic += 0.5 * trace_prod(bk.Wd[i] * nd.H, bk.Wd[i].transpose());
@@ -477,7 +475,7 @@ Energies energies(const Model& model, const VecX& q, const VecX& v, Workspace* w
     for (int k = ch.begin; k < ch.end; ++k) {
       if (L.carries(k)) continue;
       const int ik = model.rfe_index(ch.link, k);
-      rfe_pose(d.rfes[k], bk.frame[ch.link], q.segment<6>(ik), v.segment<6>(ik), ws.zero.segment<6>(ik), pose, false);
+      rfe_pose(d.rfes[k], bk.frame[ch.link], q.segment<6>(ik), v.segment<6>(ik), Vec6::Zero(), pose, false);
       SdeResult r;
       if (!(k > 0 && L.carries(k - 1))) {
         const Sde& s = d.sdes[k];

@@ -19,9 +19,8 @@ Momentum momentum(const Model& model, const VecX& q, const VecX& v, Workspace* w
   Workspace local;
   Workspace& ws = wsp ? *wsp : local;
   ws.check(model);
-  if (ws.zero.size() != model.dof()) ws.zero = VecX::Zero(model.dof());
   BaseKinematics& bk = ws.bk;
-  base_kinematics(model, q, v, ws.zero, bk);
+  base_kinematics(model, q, v, bk);
   Vec3 lin = Vec3::Zero();
   Mat3 A = Mat3::Zero();
   Vec4 s = Vec4::Zero();  // ∫[x; 1] dm
@@ -47,7 +46,7 @@ Momentum momentum(const Model& model, const VecX& q, const VecX& v, Workspace* w
     for (int k = ch.begin; k < ch.end; ++k) {
       if (L.carries(k)) continue;  // a node's body
       const int ik = model.rfe_index(ch.link, k);
-      rfe_pose(L.d.rfes[k], bk.frame[ch.link], q.segment<6>(ik), v.segment<6>(ik), ws.zero.segment<6>(ik), pose, false);
+      rfe_pose(L.d.rfes[k], bk.frame[ch.link], q.segment<6>(ik), v.segment<6>(ik), Vec6::Zero(), pose, false);
       rfe_momentum_moments(L.d.rfes[k], pose, bk.frame[ch.link], v.segment<6>(ik), l, a);
       sum.leftCols<3>() += a;
       sum.col(3) += l;

@@ -61,7 +61,7 @@ struct Workspace {
   std::vector<double> power;         ///< per chunk: sde dissipation
   std::vector<Vec6> boundary;        ///< per chunk: its first sde's force on the previous chunk's last rfe
   std::vector<Mat6> boundary_block;  ///< per chunk (and target): the same sde's block on that rfe
-  VecX zero;                         ///< zeros of the model's size
+  VecX zero;                         ///< zeros of the model's size (velocity products off: tests only)
   std::vector<BaseMoments> node_moments;  ///< per node: its subtree's (suffix sums over the tree)
   /// Cuts every link of the model into chunks, sizes the chunk arrays (cleared) and returns the
   /// number of chunks.

@@ -27,5 +27,7 @@ struct BaseKinematics {
 
 /// Evaluates the tree at full coordinates q, rates v and accelerations a (each of model.dof()).
 void base_kinematics(const Model& model, const VecX& q, const VecX& v, const VecX& a, BaseKinematics& out);
+/// The same with zero joint accelerations (no vector of the model's size needed).
+void base_kinematics(const Model& model, const VecX& q, const VecX& v, BaseKinematics& out);
 
 }  // namespace rfem

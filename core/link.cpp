@@ -156,7 +156,12 @@ Discretisation discretise(const FlexibleLink& link) {
     seg_start.push_back(x);
     x += s.length;
   }
-  // Primary division: sdes at part midpoints.
+  // Primary division: sdes at part midpoints. Reserved exactly: at 10⁴ rfes a doubling vector's
+  // spare capacity is up to 0.3 kB per rfe of a run's memory.
+  int parts = 0;
+  for (const auto& s : link.segments) parts += s.parts;
+  d.sdes.reserve(parts);
+  d.rfes.reserve(parts);
   for (size_t s = 0; s < link.segments.size(); ++s) {
     const Segment& seg = link.segments[s];
     const double dl = seg.length / seg.parts;

@@ -269,7 +269,9 @@ RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, S
     }
     smp.steps = out.stats.steps;
     smp.last_step = out.stats.last_step;
-    if (!emit(smp)) {
+    const bool emitted = emit(smp);
+    eq.give_back(smp);
+    if (!emitted) {
       out.status = emit.failure();
       return out;
     }

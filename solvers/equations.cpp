@@ -125,15 +125,8 @@ VecX EquationsOfMotion::torques(double t) const {
 
 Power EquationsOfMotion::residual(double t, const double* qu, const double* vu, const double* au, double* r) {
   RFEM_CHECK_ARGUMENT(unknowns() == 0 || r, "r must point to unknowns() values");
-  const auto start = std::chrono::steady_clock::now();
-  expand(t, qu, vu, au);
-  Power p;
-  generalised_forces(*model_, q_, v_, a_, terms_, F_, damped_ ? &p.dissipation : nullptr, &ws_);
-  if (!by_steps_) {
-    governor_.record(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-    ws_.parallel.threads = governor_.threads();
-  }
-  const VecX tau = torques(t);
+  VecX tau;
+  const Power p = forces(t, qu, vu, au, tau);
   const int u = static_cast<int>(unknown_.size()), m = model_->m();
   const int n6 = model_->flexible_dofs();  // the first unknowns, in order
   if (reduction_) rf_.resize(u);
@@ -143,6 +136,19 @@ Power EquationsOfMotion::residual(double t, const double* qu, const double* vu, 
   for (int j = 0; j < m; ++j)
     if (base_col_[j] >= 0) full[base_col_[j]] -= tau[j];
   if (reduction_) reduction_->project(full, r, u - n6);  // Galerkin: r_η = Φᵀ r_l
+  return p;
+}
+
+Power EquationsOfMotion::forces(double t, const double* qu, const double* vu, const double* au, VecX& tau) {
+  const auto start = std::chrono::steady_clock::now();
+  expand(t, qu, vu, au);
+  Power p;
+  generalised_forces(*model_, q_, v_, a_, terms_, F_, damped_ ? &p.dissipation : nullptr, &ws_);
+  if (!by_steps_) {
+    governor_.record(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    ws_.parallel.threads = governor_.threads();
+  }
+  tau = torques(t);
   p.input = tau.dot(model_->joint_coords(v_));
   return p;
 }
@@ -183,10 +189,13 @@ VecX EquationsOfMotion::accelerations(double t, const double* qu, const double* 
 
 OutputSample EquationsOfMotion::sample(double t, const double* qu, const double* vu, const double* au,
                                        double dissipated, double input_work) {
-  const VecX a = au ? Eigen::Map<const VecX>(au, unknowns()).eval()
-                    : (unknowns() > 0 ? accelerations(t, qu, vu) : VecX());
-  VecX r(unknowns());
-  residual(t, qu, vu, a.data(), r.data());  // F at these accelerations: the required torques
+  VecX a_own;
+  if (!au && unknowns() > 0) {
+    a_own = accelerations(t, qu, vu);
+    au = a_own.data();
+  }
+  VecX tau;
+  forces(t, qu, vu, au, tau);  // F at these accelerations: the required torques
   if (model_->free_base) {
     const double pitch = q_[model_->joint_index(free_base_pitch)];
     if (std::abs(pitch) > free_base_pitch_limit) {
@@ -200,15 +209,23 @@ OutputSample EquationsOfMotion::sample(double t, const double* qu, const double*
   }
   OutputSample s;
   s.t = t;
-  s.q = q_;
-  s.v = v_;
-  s.a = a_;
-  s.tau = torques(t);
+  s.tau = std::move(tau);
   s.energy = energies(*model_, q_, v_, &ws_);
   s.momentum = momentum(*model_, q_, v_, &ws_);
   s.dissipated = dissipated;
   s.input_work = input_work;
+  // The full coordinates move into the sample (copies would be 0.14 kB per rfe above the run's
+  // memory at every output); give_back returns them, and expand() sizes them again otherwise.
+  s.q.swap(q_);
+  s.v.swap(v_);
+  s.a.swap(a_);
   return s;
+}
+
+void EquationsOfMotion::give_back(OutputSample& s) {
+  if (q_.size() == 0) q_.swap(s.q);
+  if (v_.size() == 0) v_.swap(s.v);
+  if (a_.size() == 0) a_.swap(s.a);
 }
 
 void EquationsOfMotion::report_step(double seconds, long residuals) {

@@ -70,6 +70,8 @@ class EquationsOfMotion {
 
   /// Full q, v, a at t from the unknowns and the prescribed laws (a_u = 0 if `au` is null).
   void expand(double t, const double* qu, const double* vu, const double* au);
+  /// The full forces F and the joint torques τ at (t, q_u, v_u, a_u), without r_u; the power flows.
+  Power forces(double t, const double* qu, const double* vu, const double* au, VecX& tau);
   /// r_u at (t, q_u, v_u, a_u); returns the power flows of that state.
   Power residual(double t, const double* qu, const double* vu, const double* au, double* r);
   /// First-order change of a state's power flows when its accelerations move by δa_u at fixed
@@ -82,8 +84,11 @@ class EquationsOfMotion {
   VecX accelerations(double t, const double* qu, const double* vu);
   /// A complete output sample at a state: torques (inverse dynamics with the accelerations au, or,
   /// if au is null, with those of the equations at that state), energies.
+  /// The sample takes the equations' full q, v, a (the last evaluated state's, until the next
+  /// evaluation); `give_back` returns their storage once the sample is used.
   OutputSample sample(double t, const double* qu, const double* vu, const double* au, double dissipated,
                       double input_work);
+  void give_back(OutputSample& s);
   /// The inputs' breakpoints inside (0, t_end), sorted, without duplicates.
   std::vector<double> breakpoints(double t_end) const;
   /// Initial unknowns: free joints at their initial values and rates, rfes at rest relative to {r}

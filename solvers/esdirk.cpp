@@ -52,14 +52,16 @@ struct EsdirkStepper::Impl {
   const Tableau T;
   const int u, s;
   IntegratorStats st;
-  VecX q, v, a, r;
+  std::vector<VecX> alpha;  // the stage accelerations α_0 … α_{s−1}
+  VecX& a;                  // a_n, which is α_0 (first same as last): one vector, not two
+  VecX q, v, r;
   Power P;
   double Wd = 0.0, Wi = 0.0;  // dissipated energy, input work
-  std::vector<VecX> alpha;
   std::vector<Power> Ps;
   std::vector<double> cq, cv;  // the coefficients of a combination of the stages
-  // 7 + s vectors of the unknowns' size (memory per rfe matters at 10⁴ rfes): after the stages Q, V
-  // hold the new solution and Qk, Vk the error estimate.
+  // s + 9 vectors of the unknowns' size (α, q, v, r, w's two halves, Qk, Vk, Q, V; memory per rfe
+  // matters at 10⁴ rfes): after the stages Q, V hold the new solution and Qk, Vk the error estimate,
+  // and Qk, Vk, r the outputs between steps.
   VecX w, Qk, Vk, Q, V;
   double h = 0.0, t = 0.0, err_prev = 1.0, eta = 1.0, t_reached = 0.0;
   int max_newton = kMaxNewton;
@@ -75,8 +77,8 @@ struct EsdirkStepper::Impl {
   std::vector<long> next_sample;
 
   Impl(EquationsOfMotion& e, const IntegratorOptions& opts)
-      : eq(e), o(opts), T(load_tableau(opts.esdirk_table)), u(e.unknowns()), s(T.s), r(u), alpha(s, VecX::Zero(u)),
-        Ps(s), cq(s), cv(s), w(2 * u), Qk(u), Vk(u), Q(u), V(u), breaks(e.breakpoints(opts.t_end)),
+      : eq(e), o(opts), T(load_tableau(opts.esdirk_table)), u(e.unknowns()), s(T.s), alpha(s, VecX::Zero(u)),
+        a(alpha[0]), r(u), Ps(s), cq(s), cv(s), w(2 * u), Qk(u), Vk(u), Q(u), V(u), breaks(e.breakpoints(opts.t_end)),
         n_out(output_count(opts)) {
     for (int j = 0; j < static_cast<int>(e.inputs().size()); ++j)
       if (const JointInput& in = e.inputs()[j]; !in.prescribed() && in.torque->sample_time() > 0) {
@@ -250,7 +252,6 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
       bool converged = eq.setup_newton(t, q.data(), v.data(), hg);
 
       // Stages: α_0 = a_n (first same as last), then one Newton iteration per stage.
-      alpha[0] = a;
       Ps[0] = P;
       for (int i = 1; i < s && converged; ++i) {
         const double ti = t + T.c[i] * h;
@@ -368,16 +369,21 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
           const double th = (to - t) / h;
           double H[6], dH[6], ddH[6];
           hermite5(th, H, dH, ddH);
-          const VecX qo = H[0] * q + (H[1] * h) * v + (H[2] * h * h) * a + H[3] * q1 + (H[4] * h) * v1 + (H[5] * h * h) * a1;
-          const VecX vo = (dH[0] / h) * q + dH[1] * v + (dH[2] * h) * a + (dH[3] / h) * q1 + dH[4] * v1 + (dH[5] * h) * a1;
-          const VecX ao = (ddH[0] / (h * h)) * q + (ddH[1] / h) * v + ddH[2] * a + (ddH[3] / (h * h)) * q1 +
-                          (ddH[4] / h) * v1 + ddH[5] * a1;
+          // Into the error estimate's and the residual's vectors, free until the next step (an
+          // output's own three would be 0.14 kB per rfe above the integration's memory).
+          VecX &qo = eqv, &vo = evv, &ao = r;
+          qo.noalias() = H[0] * q + (H[1] * h) * v + (H[2] * h * h) * a + H[3] * q1 + (H[4] * h) * v1 + (H[5] * h * h) * a1;
+          vo.noalias() = (dH[0] / h) * q + dH[1] * v + (dH[2] * h) * a + (dH[3] / h) * q1 + dH[4] * v1 + (dH[5] * h) * a1;
+          ao.noalias() = (ddH[0] / (h * h)) * q + (ddH[1] / h) * v + ddH[2] * a + (ddH[3] / (h * h)) * q1 +
+                         (ddH[4] / h) * v1 + ddH[5] * a1;
           smp = eq.sample(to, qo.data(), vo.data(), ao.data(), hermite3(th, h, Wd, P.dissipation, Wd1, P1.dissipation),
                           hermite3(th, h, Wi, P.input, Wi1, P1.input));
         }
         smp.steps = st.steps;
         smp.last_step = h;
-        if (!emit(smp)) return emit.failure();
+        const bool emitted = emit(smp);
+        eq.give_back(smp);
+        if (!emitted) return emit.failure();
         t_reached = to;
         ++k_out;
         steps_this_output = attempts_this_output = 0;

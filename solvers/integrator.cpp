@@ -180,12 +180,12 @@ RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, 
 RunEstimate estimate_run(std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs,
                          const IntegratorOptions& opts, bool time) {
   RFEM_CHECK_ARGUMENT(model != nullptr, "no model");
-  // Peak RSS of `rfem run cases/kane_spinup.toml` grows by 2.69 kB per rfe with ESDIRK5 and the
-  // chain solver (n = 20 000 → 200 000: 72 MB → 556 MB): pattern and S, mass, damping values
-  // (~1.2 kB), stage and history vectors (~1 kB), rotation cache and model; by 4.80 kB with BDF
-  // (IDA's history and a separate stiffness; n = 20 000 → 100 000: 115 MB → 499 MB). ~18 MB is the
-  // program itself.
-  const double per_rfe = opts.kind == IntegratorKind::Bdf ? 4.80e3 : 2.69e3;
+  // Peak RSS of `rfem run cases/kane_spinup.toml` grows by 1.96 kB per rfe with ESDIRK5 and the
+  // chain solver between checkpoints (n = 20 000 → 100 000: 61 MB → 218 MB; docs/performance.md),
+  // 3.0 kB while a checkpoint is written: Newton blocks (0.58 kB), stage and state vectors (0.77 kB),
+  // model, full coordinates, and the checkpoint's copies; by 4.18 kB with BDF (IDA's history and a
+  // separate stiffness). ~18 MB is the program itself.
+  const double per_rfe = opts.kind == IntegratorKind::Bdf ? 4.18e3 : 3.0e3;
   RunEstimate e;
   e.bytes = 18e6 + per_rfe * model->n();
   if (!time) return e;

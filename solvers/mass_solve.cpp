@@ -18,21 +18,25 @@ bool solve_mass(const Model& model, const BorderedPattern& pattern, const std::v
   for (int i = 0; i < nb; ++i)
     for (int j = 0; j < nb; ++j) S(i, j) = entry(n6 + i, n6 + j);
   VecX rb = b.tail(nb);
-  std::vector<Eigen::LLT<Mat6>> llt(n);
+  // Each rfe's 6×6 block is factorised twice (here and for the back-substitution) rather than
+  // kept: n factors would be 0.3 kB per rfe at the start of a run, above the integration's peak.
+  auto block_factor = [&](int k) {
+    Mat6 Mkk;
+    for (int i = 0; i < 6; ++i)
+      for (int j = 0; j < 6; ++j) Mkk(i, j) = entry(6 * k + i, 6 * k + j);
+    return Eigen::LLT<Mat6>(Mkk);
+  };
   for (int k = 0; k < n; ++k) {
     const std::vector<int>& cols = pattern.chains()[pattern.chain_of(k)].cols;
     const int w = static_cast<int>(cols.size());
-    Mat6 Mkk;
     Eigen::Matrix<double, 6, Eigen::Dynamic> B(6, w);
-    for (int i = 0; i < 6; ++i) {
-      for (int j = 0; j < 6; ++j) Mkk(i, j) = entry(6 * k + i, 6 * k + j);
+    for (int i = 0; i < 6; ++i)
       for (int j = 0; j < w; ++j) B(i, j) = entry(6 * k + i, n6 + cols[j]);
-    }
-    llt[k].compute(Mkk);
-    if (llt[k].info() != Eigen::Success) return false;
+    const Eigen::LLT<Mat6> llt = block_factor(k);
+    if (llt.info() != Eigen::Success) return false;
     if (w > 0) {
-      const MatX s = B.transpose() * llt[k].solve(B);
-      const VecX r = B.transpose() * llt[k].solve(b.segment<6>(6 * k));
+      const MatX s = B.transpose() * llt.solve(B);
+      const VecX r = B.transpose() * llt.solve(b.segment<6>(6 * k));
       for (int i = 0; i < w; ++i) {
         rb[cols[i]] -= r[i];
         for (int j = 0; j < w; ++j) S(cols[i], cols[j]) -= s(i, j);
@@ -49,7 +53,7 @@ bool solve_mass(const Model& model, const BorderedPattern& pattern, const std::v
     Vec6 rhs = b.segment<6>(6 * k);
     for (int col : cols)
       for (int i = 0; i < 6; ++i) rhs[i] -= entry(6 * k + i, n6 + col) * b[n6 + col];
-    b.segment<6>(6 * k) = llt[k].solve(rhs);
+    b.segment<6>(6 * k) = block_factor(k).solve(rhs);
   }
   return true;
 }
