@@ -6,16 +6,15 @@ namespace rfem {
 
 namespace {
 
-// a: the joint accelerations by coordinate, or null for zero ones.
-void base_kinematics_of(const Model& model, const VecX& q, const VecX& v, const double* a, BaseKinematics& out) {
+// v, a: the joint rates and accelerations by coordinate, or null for zero ones.
+void base_kinematics_of(const Model& model, const VecX& q, const double* v, const double* a, BaseKinematics& out) {
   RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
-  RFEM_CHECK_ARGUMENT_SIZE(v.size(), model.dof(), "v");
   const int N = static_cast<int>(model.nodes.size());
   for (auto* x : {&out.W, &out.Xi, &out.Wd, &out.Wdd, &out.Omega, &out.Alpha}) x->resize(N);
   for (int i = 0; i < N; ++i) {
     const Node& nd = model.nodes[i];
     const int p = nd.parent;
-    const double qi = q[nd.coord], vi = v[nd.coord], ai = a ? a[nd.coord] : 0.0;
+    const double qi = q[nd.coord], vi = v ? v[nd.coord] : 0.0, ai = a ? a[nd.coord] : 0.0;
     const Mat4 A = nd.has_pre ? Mat4(nd.pre * joint_transform(nd.motion, qi)) : joint_transform(nd.motion, qi);
     const Mat4 W = p >= 0 ? Mat4(out.W[p] * A) : Mat4(Mat4::Identity() * A);
     const Mat4 Omega = p >= 0 ? out.Omega[p] : Mat4::Zero();  // Σ over the ancestors
@@ -49,12 +48,18 @@ void base_kinematics_of(const Model& model, const VecX& q, const VecX& v, const 
 }  // namespace
 
 void base_kinematics(const Model& model, const VecX& q, const VecX& v, const VecX& a, BaseKinematics& out) {
+  RFEM_CHECK_ARGUMENT_SIZE(v.size(), model.dof(), "v");
   RFEM_CHECK_ARGUMENT_SIZE(a.size(), model.dof(), "a");
-  base_kinematics_of(model, q, v, a.data(), out);
+  base_kinematics_of(model, q, v.data(), a.data(), out);
 }
 
 void base_kinematics(const Model& model, const VecX& q, const VecX& v, BaseKinematics& out) {
-  base_kinematics_of(model, q, v, nullptr, out);
+  RFEM_CHECK_ARGUMENT_SIZE(v.size(), model.dof(), "v");
+  base_kinematics_of(model, q, v.data(), nullptr, out);
+}
+
+void base_kinematics(const Model& model, const VecX& q, BaseKinematics& out) {
+  base_kinematics_of(model, q, nullptr, nullptr, out);
 }
 
 }  // namespace rfem

@@ -29,5 +29,7 @@ struct BaseKinematics {
 void base_kinematics(const Model& model, const VecX& q, const VecX& v, const VecX& a, BaseKinematics& out);
 /// The same with zero joint accelerations (no vector of the model's size needed).
 void base_kinematics(const Model& model, const VecX& q, const VecX& v, BaseKinematics& out);
+/// The same at rest (zero rates and accelerations): the poses.
+void base_kinematics(const Model& model, const VecX& q, BaseKinematics& out);
 
 }  // namespace rfem

@@ -50,8 +50,7 @@ void axis_points(const Model& model, int l, const std::vector<double>& s, const 
   RFEM_CHECK_INDEX(l, model.links.size(), "link");
   RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
   BaseKinematics bk;
-  const VecX z = VecX::Zero(model.dof());
-  base_kinematics(model, q, z, z, bk);
+  base_kinematics(model, q, bk);
   const Mat4& B0 = bk.frame[l].B0;
   pos.resize(s.size());
   deflection.resize(s.size());
@@ -129,8 +128,7 @@ Vec3 tip_position(const Model& model, int l, const VecX& q) {
 std::vector<Vec3> joint_positions(const Model& model, const VecX& q) {
   RFEM_CHECK_ARGUMENT_SIZE(q.size(), model.dof(), "q");
   BaseKinematics bk;
-  const VecX z = VecX::Zero(model.dof());
-  base_kinematics(model, q, z, z, bk);
+  base_kinematics(model, q, bk);
   std::vector<Vec3> out;
   for (int i : model.joint_node) out.push_back(bk.W[i].topRightCorner<3, 1>());
   return out;

@@ -9,6 +9,7 @@
 // ResultsError naming the file. Layout documented in README.md ("Results").
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -102,6 +103,8 @@ class RunWriter {
   void append(const OutputSample& s);
   /// Records a checkpoint covering every row appended so far (flushed first), in the older slot.
   void checkpoint(const std::vector<double>& state);
+  /// The same with the state in pieces, written one after the other (no copy of the state).
+  void checkpoint(const std::vector<std::span<const double>>& pieces);
   /// Writes the status, the integrator's statistics, the wall time and any warnings about the
   /// solution (attribute `warnings`, one per line), and leaves SWMR mode.
   void finish(const RunOutcome& outcome, double wall_s, const std::vector<std::string>& warnings = {});

@@ -134,6 +134,13 @@ struct EsdirkStepper::Impl {
   RunStatus start(SampleEmitter& emit);
   RunStatus advance(double until, SampleEmitter& emit);
   IntegratorState state() const;
+  IntegratorState state_scalars() const;  // state() without q, v, a
+  // Swaps q, v, a with the state's: lends them to a checkpoint, and takes them back.
+  void lend(IntegratorState& x) {
+    q.swap(x.q);
+    v.swap(x.v);
+    a.swap(x.a);
+  }
 };
 
 RunStatus EsdirkStepper::Impl::start(SampleEmitter& emit) {
@@ -408,7 +415,13 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
       if (o.max_step > 0) h = std::min(h, o.max_step);
       sample_due();
       // (A digital law's held values are the laws' own memory: the run's book checkpoints them.)
-      if (!emit.checkpoint([&] { return state(); })) return emit.failure();
+      if (emit.checkpoint_due()) {  // the state's vectors lent, not copied (0.14 kB per rfe)
+        IntegratorState x = state_scalars();
+        lend(x);
+        const bool saved = emit.checkpoint(x);
+        lend(x);  // (back)
+        if (!saved) return emit.failure();
+      }
     }
   } catch (const std::exception& e) {
     return fail(e.what());
@@ -453,6 +466,14 @@ const IntegratorStats& EsdirkStepper::stats() const { return impl_->st; }
 IntegratorState EsdirkStepper::state() const { return impl_->state(); }
 
 IntegratorState EsdirkStepper::Impl::state() const {
+  IntegratorState x = state_scalars();
+  x.q = q;
+  x.v = v;
+  x.a = a;
+  return x;
+}
+
+IntegratorState EsdirkStepper::Impl::state_scalars() const {
   const Impl& m = *this;
   IntegratorState x;
   x.t = m.t;
@@ -464,9 +485,6 @@ IntegratorState EsdirkStepper::Impl::state() const {
   x.power = m.P;
   x.next_output = m.k_out;
   x.stats = m.st;
-  x.q = m.q;
-  x.v = m.v;
-  x.a = m.a;
   return x;
 }
 

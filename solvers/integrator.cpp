@@ -59,13 +59,21 @@ RunOutcome inverse_dynamics_only(EquationsOfMotion& eq, const IntegratorOptions&
 SampleEmitter::SampleEmitter(const SampleSink& sink, const RunControl& control)
     : sink_(sink), control_(control), last_beat_(now_s()), last_checkpoint_(last_beat_) {}
 
+bool SampleEmitter::checkpoint_due() const {
+  return !failed() && control_.checkpoint && control_.checkpoint_interval > 0 &&
+         now_s() - last_checkpoint_ >= control_.checkpoint_interval;
+}
+
 bool SampleEmitter::checkpoint(const std::function<IntegratorState()>& st) {
   if (failed()) return false;
-  if (!control_.checkpoint || !(control_.checkpoint_interval > 0)) return true;
-  const double now = now_s();
-  if (now - last_checkpoint_ < control_.checkpoint_interval) return true;
+  return checkpoint_due() ? checkpoint(st()) : true;
+}
+
+bool SampleEmitter::checkpoint(const IntegratorState& st) {
+  if (failed()) return false;
+  if (!control_.checkpoint) return true;
   try {
-    control_.checkpoint(st());
+    control_.checkpoint(st);
   } catch (const std::exception& e) {
     error_ = e.what();
   } catch (...) {
@@ -180,12 +188,11 @@ RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, 
 RunEstimate estimate_run(std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs,
                          const IntegratorOptions& opts, bool time) {
   RFEM_CHECK_ARGUMENT(model != nullptr, "no model");
-  // Peak RSS of `rfem run cases/kane_spinup.toml` grows by 1.96 kB per rfe with ESDIRK5 and the
-  // chain solver between checkpoints (n = 20 000 → 100 000: 61 MB → 218 MB; docs/performance.md),
-  // 3.0 kB while a checkpoint is written: Newton blocks (0.58 kB), stage and state vectors (0.77 kB),
-  // model, full coordinates, and the checkpoint's copies; by 4.18 kB with BDF (IDA's history and a
-  // separate stiffness). ~18 MB is the program itself.
-  const double per_rfe = opts.kind == IntegratorKind::Bdf ? 4.18e3 : 3.0e3;
+  // Peak RSS of `rfem run cases/kane_spinup.toml` grows by 1.92 KiB per rfe with ESDIRK5 and the
+  // chain solver, checkpoints included (n = 20 000 → 100 000: 60 MB → 214 MB; docs/performance.md):
+  // Newton blocks (0.58 kB), stage and state vectors (0.77 kB), model (0.3 kB), full coordinates;
+  // by 4.15 KiB with BDF (IDA's history and a separate stiffness). ~18 MB is the program itself.
+  const double per_rfe = opts.kind == IntegratorKind::Bdf ? 4.25e3 : 1.97e3;
   RunEstimate e;
   e.bytes = 18e6 + per_rfe * model->n();
   if (!time) return e;

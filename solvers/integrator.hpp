@@ -101,6 +101,8 @@ struct IntegratorState {
   /// As doubles (a version number first), and back; unpack throws std::invalid_argument for a
   /// vector that is not a state of `unknowns` unknowns (−1: of any number).
   std::vector<double> pack() const;
+  /// pack()'s values before q, v, a (which follow it in that order).
+  std::vector<double> pack_head() const;
   static IntegratorState unpack(const std::vector<double>& x, int unknowns);
 };
 
@@ -173,6 +175,10 @@ class SampleEmitter {
   /// Hands the state to the caller's checkpoint if its interval has passed (`st` is called only
   /// then). False if it threw.
   bool checkpoint(const std::function<IntegratorState()>& st);
+  /// Whether a checkpoint is due (its interval has passed, nothing failed).
+  bool checkpoint_due() const;
+  /// Hands `st` to the caller's checkpoint now. False if it threw.
+  bool checkpoint(const IntegratorState& st);
   const IntegratorState* resume() const { return control_.resume; }
   bool failed() const { return !error_.empty(); }
   /// The status of a run ended by the sink or heartbeat.

@@ -12,6 +12,15 @@ constexpr int kScalars = 16;  // version … error_test_fails below; then last_s
 }  // namespace
 
 std::vector<double> IntegratorState::pack() const {
+  std::vector<double> x = pack_head();
+  x.reserve(x.size() + q.size() + v.size() + a.size());
+  x.insert(x.end(), q.data(), q.data() + q.size());
+  x.insert(x.end(), v.data(), v.data() + v.size());
+  x.insert(x.end(), a.data(), a.data() + a.size());
+  return x;
+}
+
+std::vector<double> IntegratorState::pack_head() const {
   const IntegratorStats& s = stats;
   std::vector<double> x = {kVersion,
                            t,
@@ -31,9 +40,6 @@ std::vector<double> IntegratorState::pack() const {
                            static_cast<double>(s.error_test_fails)};
   x.push_back(s.last_step);
   x.push_back(static_cast<double>(q.size()));
-  x.insert(x.end(), q.data(), q.data() + q.size());
-  x.insert(x.end(), v.data(), v.data() + v.size());
-  x.insert(x.end(), a.data(), a.data() + a.size());
   return x;
 }
 

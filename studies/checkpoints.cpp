@@ -39,17 +39,43 @@ const std::vector<double>* RunState::find(const std::string& key) const {
 
 void RunState::add(const std::string& key, std::vector<double> state) { observers.emplace_back(key_hash(key), std::move(state)); }
 
-std::vector<double> RunState::pack() const {
-  std::vector<double> x = {kVersion};
-  put_block(x, integrator.pack());
-  put_block(x, summary);
-  x.push_back(static_cast<double>(observers.size()));
+PackedState::PackedState(const IntegratorState& integrator, const std::vector<double>& summary,
+                         const std::vector<std::pair<double, std::vector<double>>>& observers) {
+  // Layout: version, block(integrator: head, q, v, a), block(summary), count, (key, block(state))….
+  own_.reserve(2 + observers.size());  // (no reallocation: the pieces point into them)
+  std::vector<double> head = integrator.pack_head();
+  const size_t state = head.size() + integrator.q.size() + integrator.v.size() + integrator.a.size();
+  head.insert(head.begin(), {kVersion, static_cast<double>(state)});
+  own_.push_back(std::move(head));
+  pieces_.emplace_back(own_.back());
+  for (const VecX* x : {&integrator.q, &integrator.v, &integrator.a})
+    pieces_.emplace_back(x->data(), static_cast<size_t>(x->size()));
+  std::vector<double> mid;
+  put_block(mid, summary);
+  mid.push_back(static_cast<double>(observers.size()));
+  own_.push_back(std::move(mid));
+  pieces_.emplace_back(own_.back());
   for (const auto& [k, v] : observers) {
-    x.push_back(k);
-    put_block(x, v);
+    own_.push_back({k, static_cast<double>(v.size())});
+    pieces_.emplace_back(own_.back());
+    pieces_.emplace_back(v);
   }
+}
+
+size_t PackedState::size() const {
+  size_t n = 0;
+  for (const auto& p : pieces_) n += p.size();
+  return n;
+}
+
+std::vector<double> PackedState::joined() const {
+  std::vector<double> x;
+  x.reserve(size());
+  for (const auto& p : pieces_) x.insert(x.end(), p.begin(), p.end());
   return x;
 }
+
+std::vector<double> RunState::pack() const { return PackedState(integrator, summary, observers).joined(); }
 
 RunState RunState::unpack(const std::vector<double>& x, int unknowns) {
   size_t i = 0;

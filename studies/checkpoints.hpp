@@ -2,6 +2,7 @@
 // What a run's checkpoint holds (results/writer.hpp stores it in the run's group): the integrator's
 // state, the run's own summary so far (peaks, energy balance, validity, outputs, wall time) and the
 // state of every observer that accumulates over a study (by its state_key), packed as doubles.
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -14,6 +15,25 @@ namespace rfem {
 void put_block(std::vector<double>& x, const std::vector<double>& block);
 /// The block at x[i] (i moves past it); std::invalid_argument(`what`) if x ends before it does.
 std::vector<double> take_block(const std::vector<double>& x, size_t& i, const std::string& what);
+
+/// A packed run state (RunState::pack's layout) as pieces in order: the integrator's q, v, a and
+/// the observers' states are pointed to, not copied (a checkpoint of n rfes then needs no memory of
+/// its own: the results file writes it piece by piece). Valid while what it points to is.
+class PackedState {
+ public:
+  PackedState(const IntegratorState& integrator, const std::vector<double>& summary,
+              const std::vector<std::pair<double, std::vector<double>>>& observers);
+  PackedState(const PackedState&) = delete;
+  PackedState& operator=(const PackedState&) = delete;
+  const std::vector<std::span<const double>>& pieces() const { return pieces_; }
+  size_t size() const;
+  /// The pieces one after the other.
+  std::vector<double> joined() const;
+
+ private:
+  std::vector<std::vector<double>> own_;  // the few values between the pointed-to blocks
+  std::vector<std::span<const double>> pieces_;
+};
 
 struct RunState {
   IntegratorState integrator;

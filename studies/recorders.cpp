@@ -1,4 +1,5 @@
 #include "rfem/studies/recorders.hpp"
+#include "rfem/studies/checkpoints.hpp"
 
 #include "rfem/results/xdmf.hpp"
 
@@ -14,7 +15,7 @@ void Hdf5Recorder::begin(const RunInfo& info) {
   run_ = info.resume ? file_.resume_run(info.name, info.model, d, *info.resume) : file_.begin_run(info.name, info.model, d);
 }
 
-void Hdf5Recorder::checkpoint(const std::vector<double>& state) { run_->checkpoint(state); }
+void Hdf5Recorder::checkpoint(const PackedState& state) { run_->checkpoint(state.pieces()); }
 
 void Hdf5Recorder::sample(const OutputSample& s) { run_->append(s); }
 

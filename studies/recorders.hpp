@@ -16,7 +16,7 @@ class Hdf5Recorder : public RunObserver {
   void begin(const RunInfo& info) override;
   void sample(const OutputSample& s) override;
   void end(const RunResult& r) override;
-  void checkpoint(const std::vector<double>& state) override;
+  void checkpoint(const PackedState& state) override;  // piece by piece into the file
   /// Output steps written of the current (or last) run.
   long samples() const { return run_ ? run_->samples() : 0; }
 

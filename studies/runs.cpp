@@ -153,10 +153,9 @@ double RunBook::wall() const {
 }
 
 void RunBook::checkpoint(const IntegratorState& st) {
-  // The run's own summary, then every observer's state.
+  // The run's own summary, then every observer's state; the integrator's state is pointed to.
   const RunResult& s = s_;
   RunState x;
-  x.integrator = st;
   x.summary = {static_cast<double>(s.samples), wall(), balance0_, s.energy_drift, s.energy_scale, static_cast<double>(s.peaks.size())};
   for (const LinkPeaks& pk : s.peaks) x.summary.insert(x.summary.end(), {pk.u1, pk.u2, pk.theta});
   const std::vector<double> v = validity_->save();
@@ -164,7 +163,7 @@ void RunBook::checkpoint(const IntegratorState& st) {
   for (RunObserver* obs : rq_.observers)
     if (const std::string key = obs->state_key(); !key.empty()) x.add(key, obs->save());
   if (std::vector<double> laws = pack_law_memory(inputs_); !laws.empty()) x.add(kLawsKey, std::move(laws));
-  const std::vector<double> packed = x.pack();
+  const PackedState packed(st, x.summary, x.observers);
   for (RunObserver* obs : rq_.observers) obs->checkpoint(packed);
 }
 

@@ -83,6 +83,8 @@ struct RunInfo {
 
 /// Sees every run of a study as it goes. A throwing sample() ends that run as failed with the
 /// message (the samples before it stay delivered); a throwing begin() or end() ends the study.
+class PackedState;
+
 class RunObserver {
  public:
   virtual ~RunObserver() = default;
@@ -92,7 +94,9 @@ class RunObserver {
   /// A checkpoint of the run (RunRequest::checkpoint_interval) after the samples so far: `state`
   /// is everything a resumed run needs (studies/checkpoints.hpp); the observer that keeps the
   /// results file stores it (Hdf5Recorder).
-  virtual void checkpoint(const std::vector<double>& /*state*/) {}
+  /// `state.joined()` is the packed vector; its pieces (studies/checkpoints.hpp) point into the
+  /// run, so an observer that stores them one by one needs no copy of the state.
+  virtual void checkpoint(const PackedState& /*state*/) {}
   /// An observer that accumulates (over the study's runs) names its state here, gives it to every
   /// checkpoint and gets it back when a run resumes; "" for none.
   virtual std::string state_key() const { return {}; }
