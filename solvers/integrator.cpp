@@ -191,10 +191,11 @@ RunEstimate estimate_run(std::shared_ptr<const Model> model, const std::vector<J
   // Peak RSS of `rfem run cases/kane_spinup.toml` grows by 1.92 KiB per rfe with ESDIRK5 and the
   // chain solver, checkpoints included (n = 20 000 → 100 000: 60 MB → 214 MB; docs/performance.md):
   // Newton blocks (0.58 kB), stage and state vectors (0.77 kB), model (0.3 kB), full coordinates;
-  // by 4.15 KiB with BDF (IDA's history and a separate stiffness). ~18 MB is the program itself.
+  // by 4.15 KiB with BDF (IDA's history and a separate stiffness). ~22 MB is the program itself
+  // (its libraries, the case, HDF5's caches: 24.0 MB at n = 1 000).
   const double per_rfe = opts.kind == IntegratorKind::Bdf ? 4.25e3 : 1.97e3;
   RunEstimate e;
-  e.bytes = 18e6 + per_rfe * model->n();
+  e.bytes = 22e6 + per_rfe * model->n();
   if (!time) return e;
   EquationsOfMotion eq(model, inputs, opts.forces, StopToken{}, opts.linear_solver, opts.parallel,
                        opts.kind == IntegratorKind::Bdf);

@@ -169,8 +169,8 @@ sed -e 's|rt_kin.h5|rt_int.h5|' rt_force.toml > rt_int.toml
 if [ $? = 0 ] && grep -q "warning: .*did not complete (interrupted (signal 2))" err.txt; then ok "incomplete source warned"
 else bad "incomplete source: $(cat err.txt)"; fi
 
-# 8. A large run says what it will cost before it starts (memory from the measured 2.69 kB per rfe:
-#    10 000 rfes are 18 MB + 27 MB; the timed step cost is positive).
+# 8. A large run says what it will cost before it starts (memory from the measured 1.92 KiB per rfe:
+#    10 000 rfes are 22 MB + 20 MB; the timed step cost is positive).
 "$rfem" run "$src/cases/kane_spinup.toml" --n 10000 --set simulation.t_end=0.05 -o big.h5 > out.txt 2> err.txt
 if [ $? = 0 ] && grep -Eq "^rfem: note: n = 10000 rfes: about 4[0-9] MB of memory; one residual evaluation [0-9.e-]+ ms, .*s per step" err.txt
 then ok "large run estimated: $(cat err.txt)"; else bad "large-run note: $(cat err.txt)"; fi
