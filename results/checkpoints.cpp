@@ -19,6 +19,7 @@ namespace {
 // checksum (kOldMagic) have no case checksum and still resume.
 constexpr double kMagic = 20261204.0, kOldMagic = 20261203.0;
 constexpr int kHeader = 9, kOldHeader = 7;
+constexpr size_t kSlotChunk = 8192;  // values per chunk of a slot (64 KiB)
 
 uint64_t fnv(uint64_t h, const unsigned char* b, size_t bytes) {
   for (size_t i = 0; i < bytes; ++i) h = (h ^ b[i]) * 1099511628211ull;
@@ -79,7 +80,7 @@ h5::Handle uncached(const std::string& what) {
 
 void RunWriter::Impl::create_checkpoints() {
   const std::string w = what("creating the checkpoints of");
-  const hsize_t dims[2] = {2, 0}, maxd[2] = {2, H5S_UNLIMITED}, chunk[2] = {1, 8192};
+  const hsize_t dims[2] = {2, 0}, maxd[2] = {2, H5S_UNLIMITED}, chunk[2] = {1, kSlotChunk};
   const h5::Handle space = h5::space(H5Screate_simple(2, dims, maxd), w);
   const h5::Handle plist = h5::plist(H5Pcreate(H5P_DATASET_CREATE), w);
   h5::check(H5Pset_chunk(plist, 2, chunk), w);
@@ -125,24 +126,34 @@ void RunWriter::checkpoint(const std::vector<std::span<const double>>& pieces) {
     const hsize_t size[2] = {2, width};
     h5::check(H5Dset_extent(w.checkpoints, size), what);
   }
-  // The slot's header, then each piece at its place in the row (a slot torn between the writes
-  // fails its checksum, as a torn single write would).
+  // The slot's header and pieces gathered chunk by chunk (64 KiB): every chunk is written once, whole,
+  // as a SWMR reader expects (a chunk written again in place could be read half old, half new).
   const h5::Handle fspace = h5::space(H5Dget_space(w.checkpoints), what);
   const h5::Handle dxpl = overwrite_list(what);
   const hsize_t row = static_cast<hsize_t>(w.checkpoint_sequence % 2);
-  auto write = [&](const double* data, size_t at, size_t count) {
-    if (count == 0) return;
-    const hsize_t start[2] = {row, at}, cnt[2] = {1, count};
+  std::vector<double> chunk;
+  chunk.reserve(kSlotChunk);
+  hsize_t at = 0;  // the column of chunk[0]
+  auto write_chunk = [&] {
+    const hsize_t start[2] = {row, at}, cnt[2] = {1, chunk.size()};
     h5::check(H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start, nullptr, cnt, nullptr), what);
     const h5::Handle mspace = h5::space(H5Screate_simple(2, cnt, nullptr), what);
-    h5::check(H5Dwrite(w.checkpoints, H5T_NATIVE_DOUBLE, mspace, fspace, dxpl, data), what);
+    h5::check(H5Dwrite(w.checkpoints, H5T_NATIVE_DOUBLE, mspace, fspace, dxpl, chunk.data()), what);
+    at += chunk.size();
+    chunk.clear();
   };
-  write(header, 0, kHeader);
-  size_t at = kHeader;
-  for (const auto& p : pieces) {
-    write(p.data(), at, p.size());
-    at += p.size();
-  }
+  auto put = [&](const double* data, size_t count) {
+    while (count > 0) {
+      const size_t part = std::min(count, kSlotChunk - chunk.size());
+      chunk.insert(chunk.end(), data, data + part);
+      data += part;
+      count -= part;
+      if (chunk.size() == kSlotChunk) write_chunk();
+    }
+  };
+  put(header, kHeader);
+  for (const auto& p : pieces) put(p.data(), p.size());
+  if (!chunk.empty()) write_chunk();
   if (w.file->swmr) h5::check(H5Dflush(w.checkpoints), what);
   w.file->flush();
 }

@@ -60,7 +60,7 @@ cat > k.toml <<TOML
 case = "$src/cases/kane_spinup.toml"
 quantities = ["peak:u1"]
 set = ["simulation.t_end=4"]
-checkpoint = 0.1
+checkpoint = 0.02
 [parameters]
 n = [$kill_n]
 "joints.0.input.T" = [10.0, 11.0, 12.0, 13.0]
@@ -80,6 +80,8 @@ while time.time() < end:
             status = [str(x) for x in f.attrs["status"]]
     except Exception:
         status = []
+    if status and status.count("completed") == len(status):
+        sys.exit(1)  # (every point ran: no later one left to catch)
     if 1 <= status.count("completed") < len(status):
         for k, st in enumerate(status):
             if st == "completed" or not os.path.exists(f"k.runs/run{k:04d}.h5"):
