@@ -91,8 +91,6 @@ void RunWriter::Impl::create_checkpoints() {
                                   "each [magic, sequence, rows, flexible rows, length, case checksum (2), checksum (2), state…]"));
 }
 
-void RunWriter::checkpoint(const std::vector<double>& state) { checkpoint({std::span<const double>(state)}); }
-
 void RunWriter::checkpoint(const std::vector<std::span<const double>>& pieces) {
   const h5::Quiet quiet;
   Impl& w = *impl_;

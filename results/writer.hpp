@@ -102,8 +102,7 @@ class RunWriter {
   RunWriter& operator=(const RunWriter&) = delete;
   void append(const OutputSample& s);
   /// Records a checkpoint covering every row appended so far (flushed first), in the older slot.
-  void checkpoint(const std::vector<double>& state);
-  /// The same with the state in pieces, written one after the other (no copy of the state).
+  /// The state comes in pieces (studies/checkpoints.hpp), written one after the other: no copy of it.
   void checkpoint(const std::vector<std::span<const double>>& pieces);
   /// Writes the status, the integrator's statistics, the wall time and any warnings about the
   /// solution (attribute `warnings`, one per line), and leaves SWMR mode.

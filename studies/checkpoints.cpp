@@ -75,8 +75,6 @@ std::vector<double> PackedState::joined() const {
   return x;
 }
 
-std::vector<double> RunState::pack() const { return PackedState(integrator, summary, observers).joined(); }
-
 RunState RunState::unpack(const std::vector<double>& x, int unknowns) {
   size_t i = 0;
   const std::string why = "the checkpoint is damaged or from another version of rfem";

@@ -16,7 +16,7 @@ void put_block(std::vector<double>& x, const std::vector<double>& block);
 /// The block at x[i] (i moves past it); std::invalid_argument(`what`) if x ends before it does.
 std::vector<double> take_block(const std::vector<double>& x, size_t& i, const std::string& what);
 
-/// A packed run state (RunState::pack's layout) as pieces in order: the integrator's q, v, a and
+/// A packed run state (the layout RunState::unpack reads) as pieces in order: the integrator's q, v, a and
 /// the observers' states are pointed to, not copied (a checkpoint of n rfes then needs no memory of
 /// its own: the results file writes it piece by piece). Valid while what it points to is.
 class PackedState {
@@ -42,7 +42,6 @@ struct RunState {
   /// The state saved under `key`, or null.
   const std::vector<double>* find(const std::string& key) const;
   void add(const std::string& key, std::vector<double> state);
-  std::vector<double> pack() const;
   /// Throws std::invalid_argument naming what does not fit (another version, another model).
   static RunState unpack(const std::vector<double>& x, int unknowns);
 };
