@@ -6,11 +6,13 @@ residual evaluations, the ratio of the wall time to the full model's kinematic r
 tolerances (what a reduced link is for: force input at about the kinematic run's cost; the aim
 is ≤ 1.5×), and the peaks of u1, u2, θ against the
 full model's at the default tolerances (relative).
+--modes: m or m:p (p: the static derivatives of the first p modes, link.derivatives; README
+"Reduced links").
 --atol: absolute tolerances [m, rad] to run every configuration at (simulation.atol; default
 1e-10). The steps of a force run are set by it, not by rtol: the rfe coordinates oscillate about
 zero, where rtol·|q| is nothing (docs/performance.md, "Reduced links").
 
-  /usr/bin/python3 bench/reduction_bench.py [--n 1000] [--modes 4,8,16] [--atol 1e-10,1e-8] [--threads 2]
+  /usr/bin/python3 bench/reduction_bench.py [--n 1000] [--modes 4,8,16,8:6] [--atol 1e-10,1e-8] [--threads 2]
       [--repeat 3] [--set key=value …]
 Threads are pinned with OMP_PROC_BIND=close OMP_PLACES=cores.
 """
@@ -20,11 +22,22 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 CASE = os.path.join(HERE, "..", "cases", "paper_deployment.toml")
 
 
-def procedure(rfem, n, threads, m, sets, tmp):
+def parse_config(x):
+    m, _, p = x.partition(":")
+    return int(m), int(p or 0)
+
+
+def label(mp):
+    m, p = mp
+    return "full" if not m else f"{m}" if not p else f"{m}:{p}"
+
+
+def procedure(rfem, n, threads, mp, sets, tmp):
     """One run of the procedure: {run name: its JSON record}."""
     env = dict(os.environ, OMP_PROC_BIND="close", OMP_PLACES="cores")
     cmd = [rfem, "--threads", str(threads), "run", CASE, "--n", str(n), "--json", "-o", os.path.join(tmp, "r.h5")]
-    for x in sets + ([f"link.modes={m}"] if m else []):
+    m, p = mp
+    for x in sets + ([f"link.modes={m}"] if m else []) + ([f"link.derivatives={p}"] if p else []):
         cmd += ["--set", x]
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if p.returncode != 0:
@@ -42,7 +55,7 @@ def main():
     ap.add_argument("--atol", default="1e-10", help="comma-separated simulation.atol values (the first the reference's)")
     ap.add_argument("--set", action="append", default=[], help="case override for every run (key.path=value)")
     a = ap.parse_args()
-    ms = [0] + [int(x) for x in a.modes.split(",")]
+    ms = [(0, 0)] + [parse_config(x) for x in a.modes.split(",")]
     atols = [float(x) for x in a.atol.split(",")]
     configs = [(m, at) for at in atols for m in ms]
     print(f"machine: {os.cpu_count()} cores, {os.uname().machine}; n = {a.n}, {a.threads} threads, median of {a.repeat} "
@@ -56,16 +69,16 @@ def main():
                 for name in ("kinematic", "force"):
                     walls[(m, at)][name].append(runs[name]["wall_time_s"])
                 last[(m, at)] = runs
-    base = (0, atols[0])
+    base = ((0, 0), atols[0])
     ref = statistics.median(walls[base]["kinematic"])
-    print(f"{'atol':>7}{'m':>5}{'run':>11}{'wall [s]':>10}{'/kin full':>10}{'steps':>8}{'resid':>8}"
+    print(f"{'atol':>7}{'m:p':>6}{'run':>11}{'wall [s]':>10}{'/kin full':>10}{'steps':>8}{'resid':>8}"
           f"{'d peak u1':>11}{'d peak u2':>11}{'d peak th':>11}")
     for m, at in configs:
         for name in ("kinematic", "force"):
             r, f = last[(m, at)][name], last[base][name]
             d = [abs(r[k] - f[k]) / abs(f[k]) for k in ("peak_u1", "peak_u2", "peak_theta")]
             w = statistics.median(walls[(m, at)][name])
-            print(f"{at:>7.0e}{m if m else 'full':>5}{name:>11}{w:>10.2f}{w / ref:>10.2f}{r['steps']:>8}{r['residual_evals']:>8}"
+            print(f"{at:>7.0e}{label(m):>6}{name:>11}{w:>10.2f}{w / ref:>10.2f}{r['steps']:>8}{r['residual_evals']:>8}"
                   f"{d[0]:>11.1e}{d[1]:>11.1e}{d[2]:>11.1e}")
 
 

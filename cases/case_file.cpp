@@ -299,6 +299,11 @@ Model build_model(const Case& c, int n) {
       throw CaseError(c.path + (c.links[l].modes_line > 0 ? ":" + std::to_string(c.links[l].modes_line) : std::string(" (--set or missing)")) + ": " +
                       c.links[l].key + ".modes: " + std::to_string(ml.d.modes) + " modes, but n = " + std::to_string(ml.d.n()) +
                       " rfes have only " + std::to_string(kModalAxes * ml.d.n()) + " to keep (5 per rfe: the axial ones stay)");
+    ml.d.derivatives = c.links[l].derivatives;
+    if (ml.d.derivatives > ml.d.modes)
+      throw CaseError(c.path + (c.links[l].derivatives_line > 0 ? ":" + std::to_string(c.links[l].derivatives_line) : std::string(" (--set or missing)")) +
+                      ": " + c.links[l].key + ".derivatives: " + std::to_string(ml.d.derivatives) +
+                      " is more than the modes kept (" + std::to_string(ml.d.modes) + "): derivatives are of kept modes");
     links.push_back(std::move(ml));
   }
   try {

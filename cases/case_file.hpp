@@ -67,6 +67,8 @@ struct LinkCase {
   int n = 0;         ///< its n if given (0: each segment's parts)
   int modes = 0;     ///< modal reduction: modes kept (0: every rfe coordinate; solvers/reduction.hpp)
   int modes_line = 0;  ///< where `modes` is written (messages; 0: not in the file)
+  int derivatives = 0;  ///< static modal derivatives of the first `derivatives` modes (solvers/modes.hpp)
+  int derivatives_line = 0;
   Mounting on;       ///< what it sits on (resolved; default: the last joint)
 };
 

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "rfem/cases/case_reading_impl.hpp"
+#include "rfem/solvers/modes.hpp"
 
 namespace rfem::reading {
 
@@ -10,7 +11,7 @@ namespace {
 
 LinkCase read_link(const Reader& r, const toml::table& lt, const std::string& key, const std::string& name,
                    const Materials& mats, const Sections& secs, ParentRef& parent) {
-  r.check_keys(lt, key, {"name", "parent", "at", "n", "modes", "damping_beta", "mount", "segments", "payloads"});
+  r.check_keys(lt, key, {"name", "parent", "at", "n", "modes", "derivatives", "damping_beta", "mount", "segments", "payloads"});
   LinkCase c;
   c.key = key;
   c.name = r.string(lt, key, "name", name);
@@ -19,6 +20,8 @@ LinkCase read_link(const Reader& r, const toml::table& lt, const std::string& ke
   c.link.damping_beta = r.non_negative(lt, key, "damping_beta", 0.0);
   c.modes = static_cast<int>(r.integer(lt, key, "modes", 0, 0, 6 * kMaxRfes));
   c.modes_line = lt.get("modes") ? static_cast<int>(lt.get("modes")->source().begin.line) : 0;
+  c.derivatives = static_cast<int>(r.integer(lt, key, "derivatives", 0, 0, kMaxDerivativeModes));
+  c.derivatives_line = lt.get("derivatives") ? static_cast<int>(lt.get("derivatives")->source().begin.line) : 0;
   parent.path = key;
   parent.node = lt.get("parent") ? lt.get("parent") : &lt;
   parent.name = r.string(lt, key, "parent", std::string());

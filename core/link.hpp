@@ -64,6 +64,9 @@ struct Discretisation {
   /// Modal reduction (solvers/reduction.hpp): keep the link's first `modes` clamped modes instead
   /// of its 6n rfe coordinates; 0 keeps every coordinate.
   int modes = 0;
+  /// Static modal derivatives (solvers/modes.hpp, link_modes) of the first `derivatives` kept modes
+  /// added to the basis as quasi-static coordinates; 0: none.
+  int derivatives = 0;
   int n() const { return static_cast<int>(rfes.size()); }
   /// Its rigid counterpart (n = 0): no rfes, rfe_0 the whole link's inertia about {r}'s origin.
   Discretisation rigid() const;

@@ -11,9 +11,12 @@ coordinate; the other five coordinates of the 60 rfes (300) become the m modal a
 2. the peaks |u1|, |u2|, |θ| of the tip and their distance from the full model's (u1 and u2 converge
    as m grows to ~1e-4 and ~1e-3; θ does not: segment B1's torsion constant as the paper prints it,
    J = 2.2e-11 m⁴, leaves its rfes nearly free to twist, and the twist the full model shows comes from
-   second-order kinematics that a basis of linear modes in rfe coordinates does not carry — README),
-3. the force run's tip u1 at a few times, full against m = 8, and its energy balance (the work of
-   the joint torques against T + V: the Galerkin projection conserves what the full model does).
+   second-order kinematics that a basis of linear modes in rfe coordinates does not carry — README);
+   with the static derivatives of the first 6 modes (`link.derivatives = 6`, docs/formulation.md §9:
+   19 second-order shapes more) all three come within 1e-4,
+3. the force run's tip u1 at a few times, full against m = 8 with and without the derivatives, and
+   the energy balance (the work of the joint torques against T + V: the Galerkin projection
+   conserves what the full model does).
 Steps and wall times vary with the machine and the build: they are on lines starting with "#".
 Measured on the project's two-core machine (one thread): force run 5 690 steps, 1.9 s (full);
 2 251, 0.7 s (m = 4); 3 765, 1.3 s (m = 8); 4 958, 2.0 s (m = 16) — at n = 60 a reduced step costs
@@ -33,38 +36,55 @@ here = os.path.dirname(os.path.abspath(__file__))
 path = os.path.join(here, "..", "cases", "paper_deployment.toml")
 N = 60
 
+CONFIGS = ((0, 0), (4, 0), (8, 0), (16, 0), (8, 6))  # (modes, derivatives)
+DERIVED = 19  # of the 21 derivatives of modes 1 … 6, those that add a shape (docs/formulation.md §9)
+
+
+def label(c):
+    m, p = c
+    return "full" if m == 0 else f"modes = {m}" + (f" + derivatives of 1…{p}" if p else "")
+
+
 results = {}
-for m in (0, 4, 8, 16):
-    case = rfem.load(path, {"link.modes": m})
-    results[m] = rfem.run(case, n=N, threads=1)
-    unknowns = 6 * N if m == 0 else N + m
-    name = "full" if m == 0 else f"modes = {m}"
+for c in CONFIGS:
+    m, p = c
+    case = rfem.load(path, {"link.modes": m, "link.derivatives": p})
+    results[c] = rfem.run(case, n=N, threads=1)
+    unknowns = 6 * N if m == 0 else N + m + (DERIVED if p else 0)
+    name = label(c)
     print(f"{name}: link 3 has {unknowns} unknowns; the kinematic and force runs (steps differ between CPUs' builds):")
     for r in ("kinematic", "force"):
-        run = results[m][r]
+        run = results[c][r]
         s = run.stats
         print(f"# {r:<9}: {s['steps']:5d} steps, {s['residual_evals']:6d} residual evaluations, wall time {run.wall_time:.2f} s")
 
 print("peaks of the tip (full) and the reduced runs' relative distance from them")
 for r in ("kinematic", "force"):
-    full = results[0][r].peaks["link"]
+    full = results[(0, 0)][r].peaks["link"]
     print(f"  {r}: full |u1| = {full['u1']:.6e} m, |u2| = {full['u2']:.6e} m, |theta| = {full['theta']:.6e} rad")
-    for m in (4, 8, 16):
-        p = results[m][r].peaks["link"]
+    for c in CONFIGS[1:]:
+        p = results[c][r].peaks["link"]
         d = [abs(p[k] - full[k]) / full[k] for k in ("u1", "u2", "theta")]
-        print(f"    modes = {m:2d}: u1 {d[0]:.1e}, u2 {d[1]:.1e}, theta {d[2]:.2f}")
+        print(f"    {label(c)}: u1 {d[0]:.1e}, u2 {d[1]:.1e}, theta {d[2]:.1e}")
+        if c[1]:
+            assert max(d) < 1e-3, d
 
-full, red = results[0]["force"], results[8]["force"]
+full, red, der = results[(0, 0)]["force"], results[(8, 0)]["force"], results[(8, 6)]["force"]
 t = full.column("time", 0)
-u_full = full.column("tip_deflection", 0)
-u_red = red.column("tip_deflection", 0)
-print("force run, tip u1 [m]: full against modes = 8")
+series = {k: np.asarray(x.column("tip_deflection", 0)) for k, x in (("full", full), ("red", red), ("der", der))}
+theta = {k: np.asarray(x.column("tip_deflection", 2)) for k, x in (("full", full), ("red", red), ("der", der))}
+print("force run, tip u1 [m]: full, modes = 8, and modes = 8 with derivatives")
 for tk in (2.0, 5.0, 10.0, 15.0, 20.0):
     k = int(np.argmin(np.abs(t - tk)))
-    print(f"  t = {t[k]:5.2f} s: {u_full[k]:+.6e}  modes = 8: {u_red[k]:+.6e}")
-print(f"  largest difference over the run: {np.abs(u_red - u_full).max() / np.abs(u_full).max():.1e} of the peak")
-for m, res in ((0, full), (8, red)):
+    print(f"  t = {t[k]:5.2f} s: {series['full'][k]:+.6e}  {series['red'][k]:+.6e}  {series['der'][k]:+.6e}")
+peak = np.abs(series["full"]).max()
+peak_theta = np.abs(theta["full"]).max()
+for k, name in (("red", "modes = 8"), ("der", "modes = 8 + derivatives")):
+    print(f"  {name}: largest difference over the run: u1 {np.abs(series[k] - series['full']).max() / peak:.1e} of its peak, "
+          f"theta {np.abs(theta[k] - theta['full']).max() / peak_theta:.1e} of its peak")
+for name, res in (("full", full), ("modes = 8", red), ("modes = 8 + derivatives", der)):
     ok = res.energy_drift < 1e-6 * res.energy_scale
-    print(f"energy balance of the force run ({'full' if m == 0 else 'modes = 8'}): drift below 1e-6 of its scale: {ok}")
+    print(f"energy balance of the force run ({name}): drift below 1e-6 of its scale: {ok}")
     assert ok
-assert np.abs(u_red - u_full).max() < 1e-2 * np.abs(u_full).max()
+assert np.abs(series["red"] - series["full"]).max() < 1e-2 * peak
+assert np.abs(theta["der"] - theta["full"]).max() < np.abs(theta["red"] - theta["full"]).max()

@@ -80,9 +80,7 @@ void EquationsOfMotion::expand(double t, const double* qu, const double* vu, con
     qf_.resize(U);
     vf_.resize(U);
     af_.resize(U);
-    reduction_->lift(qu, qf_.data(), k, true);
-    reduction_->lift(vu, vf_.data(), k, false);
-    if (au) reduction_->lift(au, af_.data(), k, false);
+    reduction_->lift_state(qu, vu, au, qf_.data(), vf_.data(), af_.data(), k, team());
     qu = qf_.data();
     vu = vf_.data();
     au = au ? af_.data() : nullptr;
@@ -135,7 +133,7 @@ Power EquationsOfMotion::residual(double t, const double* qu, const double* vu, 
   for (int i = n6; i < u; ++i) full[i] = F_[unknown_[i]];
   for (int j = 0; j < m; ++j)
     if (base_col_[j] >= 0) full[base_col_[j]] -= tau[j];
-  if (reduction_) reduction_->project(full, r, u - n6);  // Galerkin: r_η = Φᵀ r_l
+  if (reduction_) reduction_->project(full, r, u - n6, team());  // Galerkin: r_η = Φᵀ r_l
   return p;
 }
 
@@ -280,6 +278,11 @@ void EquationsOfMotion::initial_state(VecX& qu, VecX& vu, bool static_equilibriu
   const StaticResult eq = solve_static(*model_, qb, vb, TipLoads{}, so);
   qu.head(model_->flexible_dofs()) = eq.q.head(model_->flexible_dofs());
   reduce();
+}
+
+const std::vector<int>& EquationsOfMotion::quasi_static() const {
+  static const std::vector<int> none;
+  return reduction_ ? reduction_->quasi_static() : none;
 }
 
 VecX EquationsOfMotion::full_coordinates(double t, const double* xu, int order) const {

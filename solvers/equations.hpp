@@ -60,6 +60,9 @@ class EquationsOfMotion {
   const std::vector<int>& base_col() const { return ubase_col_; }
   /// The modal reduction of the model's reduced links (null if none).
   const std::shared_ptr<const Reduction>& reduction() const { return reduction_; }
+  /// Unknowns the integrators leave out of their error estimate, ascending: reduced links' modal
+  /// derivatives (Reduction::quasi_static); empty without them.
+  const std::vector<int>& quasi_static() const;
   /// Every coordinate (order 0), rate (1) or acceleration (2) at t from the unknowns' values `xu`
   /// and the prescribed joints' laws.
   VecX full_coordinates(double t, const double* xu, int order) const;

@@ -331,6 +331,7 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
         cv[j] = h * T.ev[j];
       }
       combine(eqv, r, cq.data(), evv, r, cv.data(), alpha, s, team);
+      for (int i : eq.quasi_static()) eqv[i] = evv[i] = 0.0;  // quasi-static (Reduction::quasi_static)
       weights(q, v, &q1, &v1);
       const double err = std::max(wrms(eqv, evv, w), 1e-10);
       const double expo = 1.0 / (T.embedded_order + 1);

@@ -5,7 +5,10 @@
 #include <Spectra/MatOp/SparseSymMatProd.h>
 #include <Spectra/MatOp/SymShiftInvert.h>
 
+#include <Eigen/QR>
+
 #include <algorithm>
+#include <memory>
 #include <set>
 
 #include <stdexcept>
@@ -13,6 +16,7 @@
 #include "rfem/assembly/assemble.hpp"
 #include "rfem/assembly/rfe_kernels.hpp"
 #include "rfem/solvers/cholmod_solver.hpp"
+#include "rfem/solvers/linear_solver.hpp"
 #include "rfem/solvers/reduction.hpp"
 #include "rfem/solvers/statics.hpp"
 #include "rfem/core/check.hpp"
@@ -223,13 +227,84 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
   return modes_of(model, qb, vb, count, dense_limit, free);
 }
 
-LinkModes link_modes(const Model& model, int l, const VecX& qb, int count) {
+namespace {
+
+// Static modal derivatives (docs/formulation.md §9) of the picked modes i ≤ j < p of link l of the
+// sub-model: K θ_ij = −∂²f/∂η_i∂η_j, f the static forces (sdes, gravity) about the equilibrium
+// all.q0 and K = ∂f/∂q there. The second derivative by central differences along φ_i ± φ_j with the
+// largest coordinate moved by 1e-3 (m or rad): truncation O(h²), ~1e-6 of the derivative; round-off
+// ε|f|/h² far below that. Appended to `out` over the lateral axes like the modes (x1 rows out).
+void add_modal_derivatives(const Model& sub, int l, const std::shared_ptr<const BorderedPattern>& pattern,
+                           const std::vector<double>& Mv, const ModesResult& all, const std::vector<int>& pick, int p,
+                           LinkModes& out) {
+  const MountedLink& L = sub.links[l];
+  const int n = L.n(), N = kModalAxes * n, nf = sub.flexible_dofs();
+  const std::vector<int> held(sub.m(), -1);
+  const VecX z = VecX::Zero(sub.dof());
+  MatrixTerms kt;
+  kt.stiffness = 1.0;
+  kt.gravity = true;
+  std::vector<double> Kv;
+  assemble_matrix(sub, *pattern, held, all.q0, z, kt, Kv);
+  const auto solver = make_linear_solver(LinearSolverKind::Chain, pattern);
+  if (!solver->factorize(Kv))
+    throw std::invalid_argument("link " + L.name + ": derivatives need a stiffness that is positive definite about the link's static equilibrium");
+  ForceTerms ft;
+  ft.inertia = false;
+  VecX q, f;
+  auto forces = [&](const VecX& d) {
+    q = all.q0;
+    q.head(nf) += d;
+    generalised_forces(sub, q, z, z, ft, f);
+    return VecX(f.head(nf));
+  };
+  auto lateral = [&](const VecX& x) {
+    VecX y(N);
+    for (int k = 0; k < n; ++k) y.segment<kModalAxes>(kModalAxes * k) = x.segment<kModalAxes>(sub.rfe_index(l, k) + 1);
+    return y;
+  };
+  // An orthonormal basis of the columns so far: a derivative they (nearly) span adds nothing.
+  MatX Q = Eigen::HouseholderQR<MatX>(out.shapes).householderQ() * MatX::Identity(N, out.shapes.cols());
+  for (int i = 0; i < p; ++i)
+    for (int j = i; j < p; ++j) {
+      const VecX a = all.shapes.col(pick[i]).head(nf), b = all.shapes.col(pick[j]).head(nf);
+      const double h = 1e-3 / std::max(a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff());
+      VecX theta = -(forces(h * (a + b)) - forces(h * (a - b)) - forces(h * (b - a)) + forces(-h * (a + b))) / (4 * h * h);
+      solver->solve(theta);
+      const VecX lat = lateral(theta);
+      VecX r = lat;
+      for (int pass = 0; pass < 2; ++pass) r -= Q * (Q.transpose() * r);  // (twice: classical Gram–Schmidt)
+      if (!(r.norm() > 1e-6 * lat.norm())) continue;
+      r /= r.norm();
+      Q.conservativeResize(N, Q.cols() + 1);
+      Q.col(Q.cols() - 1) = r;
+      // The column: its new direction, scaled to a largest coordinate of 1; M_bb of it.
+      VecX full = VecX::Zero(nf), Mr;
+      for (int k = 0; k < n; ++k) full.segment<kModalAxes>(sub.rfe_index(l, k) + 1) = r.segment<kModalAxes>(kModalAxes * k);
+      const double s = 1.0 / r.cwiseAbs().maxCoeff();
+      pattern->multiply(Mv, full, Mr);
+      const int c = static_cast<int>(out.shapes.cols());
+      out.shapes.conservativeResize(N, c + 1);
+      out.mass_shapes.conservativeResize(N, c + 1);
+      out.shapes.col(c) = s * r;
+      out.mass_shapes.col(c) = s * lateral(Mr);
+      out.pairs.emplace_back(i + 1, j + 1);
+    }
+}
+
+}  // namespace
+
+LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int derivatives) {
   RFEM_CHECK_INDEX(l, model.links.size(), "link");
   const MountedLink& L = model.links[l];
   const int n = L.n(), N = kModalAxes * n;
   if (count < 1 || count > N)
     throw std::invalid_argument("link " + L.name + ": modes = " + std::to_string(count) + " must be between 1 and its 5n = " +
                                 std::to_string(N) + " coordinates other than the axial ones");
+  if (derivatives < 0 || derivatives > std::min(count, kMaxDerivativeModes))
+    throw std::invalid_argument("link " + L.name + ": derivatives = " + std::to_string(derivatives) + " must be between 0 and " +
+                                std::to_string(std::min(count, kMaxDerivativeModes)) + " (the modes kept, at most " +
+                                std::to_string(kMaxDerivativeModes) + ")");
   std::vector<MountedLink> links;  // this link alone flexible (and not reduced), the others rigid
   for (size_t i = 0; i < model.links.size(); ++i) {
     MountedLink r;
@@ -262,7 +337,8 @@ LinkModes link_modes(const Model& model, int l, const VecX& qb, int count) {
                                 std::to_string(all.omega[pick[count]] / (2 * M_PI)) + " Hz): keep " +
                                 std::to_string(count - 1) + " or " + std::to_string(count + 1) + " modes");
   const std::vector<int> held(sub.m(), -1);
-  const BorderedPattern pattern(sub, held);
+  const auto shared_pattern = std::make_shared<const BorderedPattern>(sub, held);
+  const BorderedPattern& pattern = *shared_pattern;
   MatrixTerms mt;
   mt.mass = 1.0;
   std::vector<double> Mv;
@@ -284,6 +360,7 @@ LinkModes link_modes(const Model& model, int l, const VecX& qb, int count) {
       out.mass_shapes.col(c).segment<kModalAxes>(kModalAxes * k) = Mphi.segment<kModalAxes>(at + 1);
     }
   }
+  if (derivatives > 0) add_modal_derivatives(sub, l, shared_pattern, Mv, all, pick, derivatives, out);
   out.q0 = VecX::Zero(N6);
   for (int k = 0; k < n; ++k) out.q0.segment<6>(6 * k) = all.q0.segment<6>(sub.rfe_index(l, k));
   return out;

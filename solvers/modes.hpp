@@ -40,17 +40,25 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
 /// unknown of its own: solvers/reduction.hpp says why).
 constexpr int kModalAxes = 5;
 
+/// The most modes whose pairwise static derivatives a reduced link may add (p(p + 1)/2 vectors).
+constexpr int kMaxDerivativeModes = 16;
+
 /// The first `count` modes of link l clamped in its {r}: every joint held at qb, every other link
 /// rigid (its mass carried where it sits), about the link's static equilibrium there; their rows
-/// over the kModalAxes axes. What a reduced link keeps (solvers/reduction.hpp). Throws
-/// std::invalid_argument for count outside 1 … 5n or a count that cuts a pair of equal frequencies.
+/// over the kModalAxes axes. What a reduced link keeps (solvers/reduction.hpp). With
+/// `derivatives` = p > 0, the static modal derivatives of modes i ≤ j ≤ p follow them
+/// (docs/formulation.md §9): K θ_ij = −∂²f/∂η_i∂η_j, the second-order shapes a linear basis lacks,
+/// each orthogonalised against the columns before it and left out where it adds nothing (≤ 1e-6 of
+/// its norm). Throws std::invalid_argument for count outside 1 … 5n, a count that cuts a pair of
+/// equal frequencies, or derivatives outside 0 … min(count, kMaxDerivativeModes).
 struct LinkModes {
-  VecX omega;        ///< [rad/s], ascending
-  MatX shapes;       ///< 5n × count over kModalAxes axes per rfe, rfe by rfe (x1 rows left out)
+  VecX omega;        ///< the modes' [rad/s], ascending (count values: the derivatives have none)
+  MatX shapes;       ///< 5n × (count + derivatives) over kModalAxes axes per rfe, rfe by rfe (x1 rows left out)
   MatX mass_shapes;  ///< M_bb shapes (M_bb the link's mass matrix over those coordinates)
   VecX q0;           ///< the equilibrium, 6n, rfe by rfe
+  std::vector<std::pair<int, int>> pairs;  ///< (i, j), from 1, of each derivative column after the modes
 };
-LinkModes link_modes(const Model& model, int l, const VecX& qb, int count);
+LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int derivatives = 0);
 
 /// A mode is rigid when ω² is below this fraction of the stiffest coordinate's K_ii / M_ii (the
 /// round-off level of a zero eigenvalue).

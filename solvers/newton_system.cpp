@@ -40,10 +40,21 @@ bool NewtonSystem::setup(const VecX& q, const VecX& v, double h, Workspace& ws) 
   }
   h_ = h;
   if (reduction_) {
-    if (keep_stiffness_) Kr_ = projection_->reduce(K_);
-    if (damped_) Cr_ = projection_->reduce(C_);
-    base_rows_ = base_rows_ * P_;
-    return reduced_->factorize(projection_->reduce(S_));
+    const int team = ws.parallel.team(model_->n());
+    if (keep_stiffness_) Kr_ = projection_->reduce(K_, team);
+    if (damped_) Cr_ = projection_->reduce(C_, team);
+    {  // the joints' rows over the reduced unknowns: each row projected as a residual is (Pᵀ row)
+      const int k = pattern_->size() - model_->flexible_dofs();
+      MatX reduced(base_rows_.rows(), P_.cols());
+      VecX row, out(P_.cols());
+      for (long i = 0; i < base_rows_.rows(); ++i) {
+        row = base_rows_.row(i).transpose();
+        reduction_->project(row.data(), out.data(), k, team);
+        reduced.row(i) = out.transpose();
+      }
+      base_rows_ = std::move(reduced);
+    }
+    return reduced_->factorize(projection_->reduce(S_, team));
   }
   solver_->set_threads(ws.parallel.team(model_->n()));
   return solver_->factorize(S_);

@@ -1,8 +1,10 @@
 #include "rfem/solvers/reduction.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "rfem/solvers/modes.hpp"
+#include "rfem/solvers/team_parts.hpp"
 
 namespace rfem {
 
@@ -11,7 +13,7 @@ Reduction::Reduction(const Model& model, const VecX& qb) : full_rfe_(model.flexi
   for (size_t l = 0; l < model.links.size(); ++l) {
     const MountedLink& L = model.links[l];
     if (L.d.modes <= 0) continue;
-    LinkModes lm = link_modes(model, static_cast<int>(l), qb, L.d.modes);
+    LinkModes lm = link_modes(model, static_cast<int>(l), qb, L.d.modes, L.d.derivatives);
     Link r;
     r.link = static_cast<int>(l);
     for (int k = 0; k < L.n(); ++k) {
@@ -19,6 +21,7 @@ Reduction::Reduction(const Model& model, const VecX& qb) : full_rfe_(model.flexi
       for (int a = 1; a < Model::rfe_dofs; ++a) reduced[r.rfe.back() + a] = 1;  // x1 stays an unknown
     }
     r.phi = std::move(lm.shapes);
+    r.phi_rows = r.phi;
     r.mass_phi = std::move(lm.mass_shapes);
     r.gram.compute(r.phi.transpose() * r.mass_phi);
     if (r.gram.info() != Eigen::Success)
@@ -26,6 +29,8 @@ Reduction::Reduction(const Model& model, const VecX& qb) : full_rfe_(model.flexi
                                   " modes are not independent without their axial rows: keep fewer");
     r.q0 = std::move(lm.q0);
     r.omega = std::move(lm.omega);
+    r.modes = L.d.modes;
+    r.pairs = std::move(lm.pairs);
     links_.push_back(std::move(r));
   }
   for (int i = 0; i < full_rfe_; ++i)
@@ -33,6 +38,7 @@ Reduction::Reduction(const Model& model, const VecX& qb) : full_rfe_(model.flexi
   rfe_ = static_cast<int>(kept_.size());
   for (Link& r : links_) {
     r.first = rfe_;
+    for (int c = r.modes; c < r.phi.cols(); ++c) quasi_static_.push_back(rfe_ + c);
     rfe_ += static_cast<int>(r.phi.cols());
   }
 }
@@ -56,24 +62,74 @@ SparseMat Reduction::projector(int k) const {
   return P;
 }
 
-void Reduction::lift(const double* x, double* xf, int k, bool positions) const {
-  for (int i = 0; i < static_cast<int>(kept_.size()); ++i) xf[kept_[i]] = x[i];
+void Reduction::lift(const double* x, double* xf, int k, bool positions, int team) const {
+  for_team_parts(static_cast<long>(kept_.size()), team, [&](long b, long e) {
+    for (long i = b; i < e; ++i) xf[kept_[i]] = x[i];
+  });
   for (const Link& r : links_) {
-    const VecX full = r.phi * Eigen::Map<const VecX>(x + r.first, r.phi.cols());
-    for (size_t e = 0; e < r.rfe.size(); ++e)
-      for (int a = 0; a < kModalAxes; ++a)
-        xf[r.rfe[e] + 1 + a] = full[kModalAxes * e + a] + (positions ? r.q0[6 * e + 1 + a] : 0.0);
+    const Eigen::Map<const VecX> eta(x + r.first, r.phi.cols());
+    for_team_parts(static_cast<long>(r.rfe.size()), team, [&](long b, long end) {
+      for (long e = b; e < end; ++e)
+        for (int a = 0; a < kModalAxes; ++a)
+          xf[r.rfe[e] + 1 + a] = r.phi_rows.row(kModalAxes * e + a).dot(eta) + (positions ? r.q0[6 * e + 1 + a] : 0.0);
+    });
   }
   for (int j = 0; j < k; ++j) xf[full_rfe_ + j] = x[rfe_ + j];
 }
 
-void Reduction::project(const double* rf, double* r, int k) const {
-  for (int i = 0; i < static_cast<int>(kept_.size()); ++i) r[i] = rf[kept_[i]];
+void Reduction::lift_state(const double* q, const double* v, const double* a, double* qf, double* vf, double* af, int k,
+                           int team) const {
+  const int cols = a ? 3 : 2;
+  const double* x[3] = {q, v, a};
+  double* xf[3] = {qf, vf, af};
+  for_team_parts(static_cast<long>(kept_.size()), team, [&](long b, long e) {
+    for (long i = b; i < e; ++i)
+      for (int c = 0; c < cols; ++c) xf[c][kept_[i]] = x[c][i];
+  });
+  for (const Link& r : links_) {
+    const long m = r.phi.cols();
+    MatX eta(m, cols);  // η of q, v, a side by side: each row of Φ read once
+    for (int c = 0; c < cols; ++c) eta.col(c) = Eigen::Map<const VecX>(x[c] + r.first, m);
+    for_team_parts(static_cast<long>(r.rfe.size()), team, [&](long b, long end) {
+      // This part's rows as one product (Φ's m ≤ Eigen's depth block: each entry sums over η in
+      // the same order for any part, so any team gives the same bits).
+      const MatX part = r.phi_rows.middleRows(kModalAxes * b, kModalAxes * (end - b)) * eta;
+      for (long e = b; e < end; ++e)
+        for (int ax = 0; ax < kModalAxes; ++ax) {
+          const long at = r.rfe[e] + 1 + ax, row = kModalAxes * (e - b) + ax;
+          xf[0][at] = part(row, 0) + r.q0[6 * e + 1 + ax];
+          for (int c = 1; c < cols; ++c) xf[c][at] = part(row, c);
+        }
+    });
+  }
+  for (int j = 0; j < k; ++j)
+    for (int c = 0; c < cols; ++c) xf[c][full_rfe_ + j] = x[c][rfe_ + j];
+}
+
+namespace {
+constexpr long kProjectBlock = 64;  // rfes per partial sum of Φᵀ r (fixed: the sum's order is the team's own)
+}
+
+void Reduction::project(const double* rf, double* r, int k, int team) const {
+  for_team_parts(static_cast<long>(kept_.size()), team, [&](long b, long e) {
+    for (long i = b; i < e; ++i) r[i] = rf[kept_[i]];
+  });
   for (const Link& l : links_) {
-    VecX part(l.phi.rows());
-    for (size_t e = 0; e < l.rfe.size(); ++e)
-      for (int a = 0; a < kModalAxes; ++a) part[kModalAxes * e + a] = rf[l.rfe[e] + 1 + a];
-    Eigen::Map<VecX>(r + l.first, l.phi.cols()) = l.phi.transpose() * part;
+    const long n = static_cast<long>(l.rfe.size()), blocks = (n + kProjectBlock - 1) / kProjectBlock;
+    const long m = l.phi.cols();
+    MatX partial(m, blocks);  // column b: block b's Φᵀ r
+    for_team_items(blocks, team, [&](long b0, long b1) {
+      VecX lat(kModalAxes * kProjectBlock);
+      for (long b = b0; b < b1; ++b) {
+        const long e0 = b * kProjectBlock, len = std::min(n, e0 + kProjectBlock) - e0;
+        for (long e = 0; e < len; ++e)
+          for (int a = 0; a < kModalAxes; ++a) lat[kModalAxes * e + a] = rf[l.rfe[e0 + e] + 1 + a];
+        partial.col(b).noalias() = l.phi_rows.middleRows(kModalAxes * e0, kModalAxes * len).transpose() * lat.head(kModalAxes * len);
+      }
+    });
+    Eigen::Map<VecX> out(r + l.first, m);
+    out.setZero();
+    for (long b = 0; b < blocks; ++b) out += partial.col(b);
   }
   for (int j = 0; j < k; ++j) r[rfe_ + j] = rf[full_rfe_ + j];
 }
@@ -118,9 +174,13 @@ Projection::Projection(const Reduction& red, const BorderedPattern& pattern) : r
   const int L = static_cast<int>(links.size());
   std::vector<int> to(n, -1);
   link_of_.assign(n, -1);
+  phi_row_.assign(n, -1);
   for (int l = 0; l < L; ++l)
     for (size_t e = 0; e < links[l].rfe.size(); ++e)
-      for (int ax = 0; ax < kModalAxes; ++ax) link_of_[links[l].rfe[e] + 1 + ax] = l;
+      for (int ax = 0; ax < kModalAxes; ++ax) {
+        link_of_[links[l].rfe[e] + 1 + ax] = l;
+        phi_row_[links[l].rfe[e] + 1 + ax] = kModalAxes * static_cast<int>(e) + ax;
+      }
   for (int i = 0, k = 0; i < red.full_rfe(); ++i)
     if (link_of_[i] < 0) to[i] = k++;
   for (int j = 0; j < joints; ++j) to[red.full_rfe() + j] = red.rfe() + j;
@@ -164,48 +224,69 @@ Projection::Projection(const Reduction& red, const BorderedPattern& pattern) : r
   source_.resize(static_cast<size_t>(R_.nonZeros()));
   for (long k = 0; k < R_.nonZeros(); ++k) source_[static_cast<size_t>(k)] = src[static_cast<size_t>(R_.valuePtr()[k])];
   W_.resize(static_cast<size_t>(L));
+  for (int l = 0; l < L; ++l) W_[static_cast<size_t>(l)].resize(S_.rows(), links[l].phi.cols());
+  wb_.resize(static_cast<size_t>(L * L));
   G_.resize(static_cast<size_t>(L * L));
 }
 
-const SparseMat& Projection::reduce(const std::vector<double>& values) {
+namespace {
+constexpr int kGramBlock = 8;  // columns of Φ_lᵀ W_l' per product (fixed: each entry's sum is the same for any team)
+}
+
+const SparseMat& Projection::reduce(const std::vector<double>& values, int team) {
   double* v = S_.valuePtr();
-  for (size_t k = 0; k < slot_.size(); ++k) v[k] = values[static_cast<size_t>(slot_[k])];
+  const long n = S_.rows();
   const auto& links = red_->links();
   const int L = static_cast<int>(links.size());
-  for (int l = 0; l < L; ++l) {  // W_l = S Φ_l: over link l's lateral columns of S
-    const MatX& phi = links[l].phi;
-    RowMat& W = W_[static_cast<size_t>(l)];
-    W.setZero(S_.rows(), phi.cols());
-    for (size_t e = 0; e < links[l].rfe.size(); ++e)
-      for (int ax = 0; ax < kModalAxes; ++ax) {
-        const int col = links[l].rfe[e] + 1 + ax;
-        const auto row = phi.row(kModalAxes * static_cast<int>(e) + ax);
-        for (SparseMat::InnerIterator it(S_, col); it; ++it) W.row(it.row()) += it.value() * row;
+  for_team_parts(static_cast<long>(slot_.size()), team, [&](long b, long e) {
+    for (long k = b; k < e; ++k) v[k] = values[static_cast<size_t>(slot_[k])];
+  });
+  // W_l = S Φ_l row by row: row i from S's column i (S is symmetric), its lateral entries.
+  for_team_parts(n, team, [&](long b, long e) {
+    for (int l = 0; l < L; ++l) W_[static_cast<size_t>(l)].middleRows(b, e - b).setZero();
+    for (long i = b; i < e; ++i)
+      for (SparseMat::InnerIterator it(S_, i); it; ++it) {
+        const int j = static_cast<int>(it.row()), l = link_of_[j];
+        if (l >= 0) W_[static_cast<size_t>(l)].row(i) += it.value() * links[l].phi_rows.row(phi_row_[j]);
       }
-  }
-  for (int l = 0; l < L; ++l) {  // the lateral rows of each link, then Φ_lᵀ W_l'
+  });
+  for (int l = 0; l < L; ++l)  // the lateral rows of each link, then Φ_lᵀ W_l' in column blocks
     for (int l2 = 0; l2 < L; ++l2) {
+      const size_t p = static_cast<size_t>(l * L + l2);
       const RowMat& W = W_[static_cast<size_t>(l2)];
-      wb_.resize(links[l].phi.rows(), W.cols());
-      for (size_t e = 0; e < links[l].rfe.size(); ++e)
-        wb_.middleRows<kModalAxes>(kModalAxes * static_cast<int>(e)) = W.middleRows<kModalAxes>(links[l].rfe[e] + 1);
-      G_[static_cast<size_t>(l * L + l2)].noalias() = links[l].phi.transpose() * wb_;
+      RowMat& wb = wb_[p];
+      wb.resize(links[l].phi.rows(), W.cols());
+      for_team_parts(static_cast<long>(links[l].rfe.size()), team, [&](long b, long e) {
+        for (long k = b; k < e; ++k) wb.middleRows<kModalAxes>(kModalAxes * k) = W.middleRows<kModalAxes>(links[l].rfe[k] + 1);
+      });
+      MatX& G = G_[p];
+      G.resize(links[l].phi.cols(), W.cols());
+      const long blocks = (W.cols() + kGramBlock - 1) / kGramBlock;
+      for_team_items(blocks, team, [&](long b0, long b1) {
+        for (long b = b0; b < b1; ++b) {
+          const long c0 = b * kGramBlock, w = std::min<long>(kGramBlock, W.cols() - c0);
+          G.middleCols(c0, w).noalias() = links[l].phi.transpose() * wb.middleCols(c0, w);
+        }
+      });
     }
-  }
   double* out = R_.valuePtr();
-  for (size_t k = 0; k < source_.size(); ++k) {
-    const Source& s = source_[k];
-    out[k] = s.kind == Source::S ? v[s.a] : s.kind == Source::W ? W_[static_cast<size_t>(s.block)](s.a, s.c)
-                                                                : G_[static_cast<size_t>(s.block)](s.a, s.c);
-  }
+  for_team_parts(static_cast<long>(source_.size()), team, [&](long b, long e) {
+    for (long k = b; k < e; ++k) {
+      const Source& s = source_[static_cast<size_t>(k)];
+      out[k] = s.kind == Source::S ? v[s.a] : s.kind == Source::W ? W_[static_cast<size_t>(s.block)](s.a, s.c)
+                                                                  : G_[static_cast<size_t>(s.block)](s.a, s.c);
+    }
+  });
   return R_;
 }
 
 std::vector<std::string> Reduction::names(const Model& model, const std::vector<std::string>& full_names) const {
   std::vector<std::string> out;
   for (int i : kept_) out.push_back(full_names[i]);
-  for (const Link& l : links_)
-    for (int c = 0; c < l.phi.cols(); ++c) out.push_back(model.links[l.link].name + "/eta" + std::to_string(c + 1));
+  for (const Link& l : links_) {
+    for (int c = 0; c < l.modes; ++c) out.push_back(model.links[l.link].name + "/eta" + std::to_string(c + 1));
+    for (const auto& [i, j] : l.pairs) out.push_back(model.links[l.link].name + "/xi" + std::to_string(i) + "_" + std::to_string(j));
+  }
   return out;
 }
 

@@ -34,11 +34,14 @@ class Reduction {
     int link = 0;           ///< the model's link
     int first = 0;          ///< its first column among the reduced rfe unknowns
     std::vector<int> rfe;   ///< first full coordinate of each of its rfes
-    MatX phi;               ///< 5n × m, rows rfe by rfe (k = 0 … n − 1), axes x2 … φ3
+    MatX phi;               ///< 5n × (m + its derivatives), rows rfe by rfe (k = 0 … n − 1), axes x2 … φ3
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> phi_rows;  ///< Φ_l row-major (lift, project)
     MatX mass_phi;          ///< M_bb Φ_l over the same coordinates
     Eigen::LLT<MatX> gram;  ///< of Φ_lᵀ M_bb Φ_l: the M-orthogonal projection back, G η = (M Φ)ᵀ (q − q0)
     VecX q0;                ///< 6n, rfe by rfe (x1 unused)
     VecX omega;             ///< the m clamped frequencies [rad/s]
+    int modes = 0;          ///< m: the columns of Φ_l after them are modal derivatives
+    std::vector<std::pair<int, int>> pairs;  ///< the modes (from 1) of each derivative column
   };
 
   /// The reduction of every link with d.modes > 0, its modes taken at joint values qb. Throws
@@ -53,22 +56,33 @@ class Reduction {
   const std::vector<Link>& links() const { return links_; }
   /// P over 6n + k coordinates (k joints appended), as a sparse matrix.
   SparseMat projector(int k) const;
-  /// x_full (6n + k) = P x (+ q0 if `positions`), x of rfe() + k values.
-  void lift(const double* x, double* x_full, int k, bool positions) const;
-  /// r = Pᵀ r_full.
-  void project(const double* r_full, double* r, int k) const;
+  /// x_full (6n + k) = P x (+ q0 if `positions`), x of rfe() + k values; on `team` threads
+  /// (rfe by rfe: the same bits for any team).
+  void lift(const double* x, double* x_full, int k, bool positions, int team = 1) const;
+  /// lift of positions q (with q0), rates v and accelerations a (a may be null) in one pass over Φ.
+  void lift_state(const double* q, const double* v, const double* a, double* qf, double* vf, double* af, int k,
+                  int team = 1) const;
+  /// r = Pᵀ r_full; on `team` threads (Φᵀ r summed over fixed blocks of rfes in order: the same
+  /// bits for any team).
+  void project(const double* r_full, double* r, int k, int team = 1) const;
   /// The reduced coordinates nearest (M-orthogonal for reduced links) to full ones.
   void restrict(const double* x_full, double* x, int k, bool positions) const;
   /// Pᵀ S P for the symmetric matrix with upper triangle `values` on a pattern of 6n + k unknowns
   /// (once; a Projection does it repeatedly).
   SparseMat reduce(const BorderedPattern& pattern, const std::vector<double>& values) const;
-  /// Names of the reduced rfe unknowns: the kept ones' (from the full names), then LINK/eta1 ….
+  /// Names of the reduced rfe unknowns: the kept ones' (from the full names), then LINK/eta1 …
+  /// and each derivative's LINK/xi_i_j.
   std::vector<std::string> names(const Model& model, const std::vector<std::string>& full_names) const;
+  /// The reduced unknowns that are modal derivatives, ascending. They are quasi-static corrections
+  /// (second-order shapes, docs/formulation.md §9): the integrators leave them out of the error
+  /// estimate (their Newton convergence is still tested), so the steps follow the modes.
+  const std::vector<int>& quasi_static() const { return quasi_static_; }
 
  private:
   int full_rfe_ = 0, rfe_ = 0;
   std::vector<int> kept_;  ///< full index of each kept rfe coordinate (they come first)
   std::vector<Link> links_;
+  std::vector<int> quasi_static_;
 };
 
 /// Pᵀ S P for matrices S on one pattern, again and again. Its layout is fixed once: S's compressed
@@ -80,8 +94,9 @@ class Reduction {
 class Projection {
  public:
   Projection(const Reduction& reduction, const BorderedPattern& pattern);
-  /// Pᵀ S P for the upper triangle `values` (pattern.nnz()); valid until the next call.
-  const SparseMat& reduce(const std::vector<double>& values);
+  /// Pᵀ S P for the upper triangle `values` (pattern.nnz()); valid until the next call. On `team`
+  /// threads: W_l row by row, Φ_lᵀ W_l' in fixed column blocks (the same bits for any team).
+  const SparseMat& reduce(const std::vector<double>& values, int team = 1);
 
  private:
   struct Source {      // where a reduced entry's value comes from
@@ -95,8 +110,9 @@ class Projection {
   std::vector<Source> source_;  // R_'s value k
   using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   std::vector<int> link_of_;    // per full coordinate: its reduced link (−1: kept)
-  std::vector<RowMat> W_;       // S Φ_l over every full row (rows: S's columns are added row-wise)
-  RowMat wb_;                   // W_l' at link l's lateral rows
+  std::vector<int> phi_row_;    // per full coordinate of a reduced link: its row of Φ_l
+  std::vector<RowMat> W_;       // S Φ_l over every full row (row i from S's column i: S is symmetric)
+  std::vector<RowMat> wb_;      // W_l' at link l's lateral rows, per link pair
   std::vector<MatX> G_;         // Φ_lᵀ W_l' per link pair (l·links + l')
 };
 

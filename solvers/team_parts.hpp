@@ -27,4 +27,19 @@ void for_team_parts(long n, int team, F&& f) {
   }
 }
 
+/// f(begin, end) for the parts of [0, n) items on `team` threads, cut evenly (no cache-line
+/// rounding: for a few blocks of work, each many lines long).
+template <class F>
+void for_team_items(long n, int team, F&& f) {
+  if (team <= 1) {
+    f(0L, n);
+    return;
+  }
+#pragma omp parallel num_threads(team)
+  {
+    const int t = omp_get_thread_num(), T = omp_get_num_threads();
+    f(n * t / T, n * (t + 1) / T);
+  }
+}
+
 }  // namespace rfem

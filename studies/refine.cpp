@@ -68,6 +68,7 @@ Case with_modes(const Case& cs, int n, int m) {
     if (model.links[l].n() > 0) {
       c.links[l].modes = m;
       c.links[l].modes_line = 0;
+      c.links[l].derivatives = std::min(c.links[l].derivatives, m);  // (of the modes kept)
     }
   return c;
 }

@@ -52,7 +52,7 @@ ModelSummary show_model(const Case& cs, int n) {
   s.dof = M.dof();
   s.unknowns = M.flexible_dofs();
   for (const MountedLink& L : M.links)  // a reduced link: its axial coordinates and its modes (solvers/reduction.hpp)
-    if (L.d.modes > 0) s.unknowns -= kModalAxes * L.n() - L.d.modes;
+    if (L.d.modes > 0) s.unknowns -= kModalAxes * L.n() - L.d.modes - L.d.derivatives * (L.d.derivatives + 1) / 2;
   for (const InputSpec& in : cs.inputs) s.unknowns += in.prescribed() ? 0 : 1;
   // Children of every entity (a joint j is 2j, a link l is 2l + 1; the ground is −1).
   auto key = [](bool joint, int i) { return joint ? 2 * i : 2 * i + 1; };
@@ -110,7 +110,9 @@ ModelSummary show_model(const Case& cs, int n) {
                                 parts[l][g] > 1 ? "s" : "");
       }
       if (L.d.modes > 0)
-        e.detail += fmt::format("; reduced: {} mode{} and its {} axial coordinates", L.d.modes, L.d.modes > 1 ? "s" : "", L.n());
+        e.detail += fmt::format("; reduced: {} mode{}{} and its {} axial coordinates", L.d.modes, L.d.modes > 1 ? "s" : "",
+                                L.d.derivatives > 0 ? fmt::format(", at most {} modal derivatives", L.d.derivatives * (L.d.derivatives + 1) / 2) : "",
+                                L.n());
       std::vector<int> idx;  // its rfes' coordinates (an rfe that carries something sits in the border)
       for (int r = 0; r < L.n(); ++r)
         for (int a = 0; a < Model::rfe_dofs; ++a) idx.push_back(M.rfe_index(l, r) + a);

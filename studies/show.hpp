@@ -25,7 +25,7 @@ struct TreeEntry {
 struct ModelSummary {
   std::string name;
   int n = 0, m = 0, dof = 0;
-  int unknowns = 0;          ///< rfe coordinates (a reduced link's: axial + modes) + joints under force input
+  int unknowns = 0;          ///< rfe coordinates (a reduced link's: axial + modes + at most d(d + 1)/2 derivatives) + joints under force input
   double mass = 0.0;         ///< of every body [kg]
   std::vector<TreeEntry> entries;  ///< depth first, children after their parent
   std::string urdf;                ///< the URDF file of the base ("" if none)
