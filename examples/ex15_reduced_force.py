@@ -18,10 +18,10 @@ coordinate; the other five coordinates of the 60 rfes (300) become the m modal a
    the energy balance (the work of the joint torques against T + V: the Galerkin projection
    conserves what the full model does).
 Steps and wall times vary with the machine and the build: they are on lines starting with "#".
-Measured on the project's two-core machine (one thread): force run 5 690 steps, 1.9 s (full);
-2 251, 0.7 s (m = 4); 3 765, 1.3 s (m = 8); 4 958, 2.0 s (m = 16) — at n = 60 a reduced step costs
-about what a full one does (the full residual is still evaluated, and the projection is added), and
-the coupled modes of the kept shapes reach tens of Hz:
+Measured on the project's two-core machine (one thread): force run 5 690 steps, 1.2 s (full);
+2 251, 0.6 s (m = 4); 3 766, 1.0 s (m = 8); 4 958, 1.4 s (m = 16); 4 182, 1.8 s (m = 8 with the
+derivatives) — at n = 60 a reduced step costs about what a full one does (the full residual is still
+evaluated, and the projection is added), and the coupled modes of the kept shapes reach tens of Hz:
 bench/reduction_bench.py measures n = 1 000.
 
     PYTHONPATH=build/python /usr/bin/python3 examples/ex15_reduced_force.py        (~8 s)
