@@ -311,6 +311,7 @@ LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int d
     r.name = model.links[i].name;
     r.d = static_cast<int>(i) == l ? model.links[i].d : model.links[i].d.rigid();
     r.d.modes = 0;
+    r.d.derivatives = 0;
     r.on = model.links[i].on;
     links.push_back(std::move(r));
   }
