@@ -12,10 +12,10 @@ namespace rfem {
 /// The first index of part t of [0, n) cut into T parts (at multiples of 8: a cache line of doubles).
 inline long team_part(long n, int t, int T) { return t >= T ? n : (n * t / T) / 8 * 8; }
 
-/// f(begin, end) for the parts of [0, n) on `team` threads (on the caller's alone if team ≤ 1).
-/// f runs inside an OpenMP region: it must not throw.
-template <class F>
-void for_team_parts(long n, int team, F&& f) {
+/// f(begin, end) for the parts of [0, n) on `team` threads (on the caller's alone if team ≤ 1), part
+/// t starting at cut(t, T). f runs inside an OpenMP region: it must not throw.
+template <class Cut, class F>
+void for_parts(long n, int team, Cut&& cut, F&& f) {
   if (team <= 1) {
     f(0L, n);
     return;
@@ -23,23 +23,21 @@ void for_team_parts(long n, int team, F&& f) {
 #pragma omp parallel num_threads(team)
   {
     const int t = omp_get_thread_num(), T = omp_get_num_threads();
-    f(team_part(n, t, T), team_part(n, t + 1, T));
+    f(cut(t, T), cut(t + 1, T));
   }
 }
 
-/// f(begin, end) for the parts of [0, n) items on `team` threads, cut evenly (no cache-line
-/// rounding: for a few blocks of work, each many lines long).
+/// The parts of [0, n) doubles, cut at cache lines (team_part).
+template <class F>
+void for_team_parts(long n, int team, F&& f) {
+  for_parts(n, team, [n](int t, int T) { return team_part(n, t, T); }, f);
+}
+
+/// The parts of [0, n) items cut evenly (no cache-line rounding: for a few blocks of work, each
+/// many lines long).
 template <class F>
 void for_team_items(long n, int team, F&& f) {
-  if (team <= 1) {
-    f(0L, n);
-    return;
-  }
-#pragma omp parallel num_threads(team)
-  {
-    const int t = omp_get_thread_num(), T = omp_get_num_threads();
-    f(n * t / T, n * (t + 1) / T);
-  }
+  for_parts(n, team, [n](int t, int T) { return t >= T ? n : n * t / T; }, f);
 }
 
 }  // namespace rfem
