@@ -10,6 +10,8 @@
 
 #include <csignal>
 
+#include <omp.h>
+
 #include "commands.hpp"
 #include "rfem/results/errors.hpp"
 #include "rfem/version.hpp"
@@ -204,6 +206,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   Eigen::setNbThreads(1);  // librfem parallelises itself (--threads goes to each call)
+  // and no call the program makes uses more than --threads, whether it is passed them or not
+  if (common.threads > 0) omp_set_num_threads(common.threads);
   spdlog::set_default_logger(spdlog::stderr_logger_mt("rfem"));
   spdlog::set_pattern("[%H:%M:%S.%e] %v");
   spdlog::set_level(common.verbose ? spdlog::level::debug : spdlog::level::warn);

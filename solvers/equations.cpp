@@ -55,7 +55,7 @@ EquationsOfMotion::EquationsOfMotion(std::shared_ptr<const Model> model_ptr, std
   ubase_col_ = base_col_;
   VecX qb(model.m());  // the reduced links' modes: at the joints' initial values
   for (int j = 0; j < model.m(); ++j) qb[j] = inputs[j].prescribed() ? inputs[j].motion->at(0.0).q : inputs[j].q0;
-  reduction_ = Reduction::of(model, qb);
+  reduction_ = Reduction::of(model, qb, parallel);
   if (reduction_) {
     nu_ = reduction_->rfe() + (nu_ - n6);
     for (int& c : ubase_col_)

@@ -204,7 +204,7 @@ void separate_degenerate(const VecX& lambda, MatX& shapes, VecX& uncertainty, co
 
 namespace {
 ModesResult modes_of(const Model& model, const VecX& qb, const VecX& vb, int count, int dense_limit,
-                     const std::vector<int>& free);
+                     const std::vector<int>& free, const Parallelism& parallel);
 // K of the modal problem: elastic with its geometric term, gravity, centrifugal at the rates vb.
 MatrixTerms stiffness_terms(const VecX& vb) {
   MatrixTerms terms;
@@ -214,17 +214,17 @@ MatrixTerms stiffness_terms(const VecX& vb) {
   return terms;
 }
 ModesResult reduced_modes(const Model& model, const Reduction& red, const VecX& qb, const VecX& vb, int count,
-                          const std::vector<int>& free);
+                          const std::vector<int>& free, const Parallelism& parallel);
 }  // namespace
 
 ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, int count, int dense_limit,
-                          const std::vector<int>& free) {
+                          const std::vector<int>& free, const Parallelism& parallel) {
   if (model.n() == 0) throw std::invalid_argument("modal analysis needs a flexible link (n ≥ 1)");
   for (const MountedLink& L : model.links)
     if (L.n() == 0) throw std::invalid_argument("modal analysis needs every link flexible (link " + L.name + " has n = 0)");
   RFEM_CHECK_ARGUMENT_SIZE(qb.size(), model.m(), "qb (joint values)");
-  if (const auto red = Reduction::of(model, qb)) return reduced_modes(model, *red, qb, vb, count, free);
-  return modes_of(model, qb, vb, count, dense_limit, free);
+  if (const auto red = Reduction::of(model, qb, parallel)) return reduced_modes(model, *red, qb, vb, count, free, parallel);
+  return modes_of(model, qb, vb, count, dense_limit, free, parallel);
 }
 
 namespace {
@@ -236,7 +236,7 @@ namespace {
 // ε|f|/h² far below that. Appended to `out` over the lateral axes like the modes (x1 rows out).
 void add_modal_derivatives(const Model& sub, int l, const std::shared_ptr<const BorderedPattern>& pattern,
                            const std::vector<double>& Mv, const ModesResult& all, const std::vector<int>& pick, int p,
-                           LinkModes& out) {
+                           const Parallelism& parallel, LinkModes& out) {
   const MountedLink& L = sub.links[l];
   const int n = L.n(), N = kModalAxes * n, nf = sub.flexible_dofs();
   const std::vector<int> held(sub.m(), -1);
@@ -245,8 +245,10 @@ void add_modal_derivatives(const Model& sub, int l, const std::shared_ptr<const 
   kt.stiffness = 1.0;
   kt.gravity = true;
   std::vector<double> Kv;
-  assemble_matrix(sub, *pattern, held, all.q0, z, kt, Kv);
+  Workspace ws(sub, parallel);
+  assemble_matrix(sub, *pattern, held, all.q0, z, kt, Kv, &ws);
   const auto solver = make_linear_solver(LinearSolverKind::Chain, pattern);
+  solver->set_threads(parallel.team(sub.n()));
   if (!solver->factorize(Kv))
     throw std::invalid_argument("link " + L.name + ": derivatives need a stiffness that is positive definite about the link's static equilibrium");
   ForceTerms ft;
@@ -255,7 +257,7 @@ void add_modal_derivatives(const Model& sub, int l, const std::shared_ptr<const 
   auto forces = [&](const VecX& d) {
     q = all.q0;
     q.head(nf) += d;
-    generalised_forces(sub, q, z, z, ft, f);
+    generalised_forces(sub, q, z, z, ft, f, nullptr, &ws);
     return VecX(f.head(nf));
   };
   auto lateral = [&](const VecX& x) {
@@ -294,7 +296,7 @@ void add_modal_derivatives(const Model& sub, int l, const std::shared_ptr<const 
 
 }  // namespace
 
-LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int derivatives) {
+LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int derivatives, const Parallelism& parallel) {
   RFEM_CHECK_INDEX(l, model.links.size(), "link");
   const MountedLink& L = model.links[l];
   const int n = L.n(), N = kModalAxes * n;
@@ -323,7 +325,7 @@ LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int d
   ModesResult all;
   std::vector<int> pick;
   for (int want = std::min(N6, 2 * count + 8);; want = std::min(N6, 2 * want)) {
-    all = modes_of(sub, qb, VecX(), want, 2 * want > N6 ? N6 : 600, {});
+    all = modes_of(sub, qb, VecX(), want, 2 * want > N6 ? N6 : 600, {}, parallel);
     pick.clear();
     for (int i = 0; i < want && static_cast<int>(pick.size()) <= count; ++i)
       if (all.kind[i] != ModeKind::Axial) pick.push_back(i);
@@ -343,7 +345,8 @@ LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int d
   MatrixTerms mt;
   mt.mass = 1.0;
   std::vector<double> Mv;
-  assemble_matrix(sub, pattern, held, all.q0, VecX::Zero(sub.dof()), mt, Mv);
+  Workspace ws(sub, parallel);
+  assemble_matrix(sub, pattern, held, all.q0, VecX::Zero(sub.dof()), mt, Mv, &ws);
   // The shapes over the coordinates a reduced link's modes span (its x1 stay unknowns of their own)
   // and M_bb Φ_b over them: the x1 rows of M Φ left out, which is M_bb Φ_b + M_b1 Φ_1.
   LinkModes out;
@@ -361,7 +364,7 @@ LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int d
       out.mass_shapes.col(c).segment<kModalAxes>(kModalAxes * k) = Mphi.segment<kModalAxes>(at + 1);
     }
   }
-  if (derivatives > 0) add_modal_derivatives(sub, l, shared_pattern, Mv, all, pick, derivatives, out);
+  if (derivatives > 0) add_modal_derivatives(sub, l, shared_pattern, Mv, all, pick, derivatives, parallel, out);
   out.q0 = VecX::Zero(N6);
   for (int k = 0; k < n; ++k) out.q0.segment<6>(6 * k) = all.q0.segment<6>(sub.rfe_index(l, k));
   return out;
@@ -369,7 +372,7 @@ LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int d
 
 namespace {
 ModesResult modes_of(const Model& model, const VecX& qb, const VecX& vb, int count, int dense_limit,
-                     const std::vector<int>& free) {
+                     const std::vector<int>& free, const Parallelism& parallel) {
   const int n = model.n(), nf = static_cast<int>(free.size()), N = model.flexible_dofs() + nf;
   if (std::set<int>(free.begin(), free.end()).size() != free.size())
     throw std::invalid_argument("a joint is freed twice");
@@ -379,14 +382,17 @@ ModesResult modes_of(const Model& model, const VecX& qb, const VecX& vb, int cou
   if (count < 1 || count > N)
     throw std::invalid_argument("mode count must be between 1 and 6n + free joints = " + std::to_string(N));
   ModesResult res;
-  res.q0 = solve_static(model, qb, vb, TipLoads{}).q;  // (checks the sizes of qb and vb)
+  StaticOptions so;
+  so.parallel = parallel;
+  res.q0 = solve_static(model, qb, vb, TipLoads{}, so).q;  // (checks the sizes of qb and vb)
+  Workspace ws(model, parallel);
   VecX v = VecX::Zero(model.dof());
   if (vb.size()) model.joint_coords(v) = vb;
   std::vector<int> cols(model.m(), -1);
   for (int i = 0; i < nf; ++i) cols[free[i]] = model.flexible_dofs() + i;
   if (nf > 0) {  // a free joint must be in equilibrium where the held ones are
     VecX F;
-    generalised_forces(model, res.q0, v, VecX::Zero(model.dof()), ForceTerms{}, F);
+    generalised_forces(model, res.q0, v, VecX::Zero(model.dof()), ForceTerms{}, F, nullptr, &ws);
     const VecX tau = model.joint_coords(F);
     const double scale = std::max(1.0, tau.cwiseAbs().maxCoeff());
     for (int j : free)
@@ -399,12 +405,12 @@ ModesResult modes_of(const Model& model, const VecX& qb, const VecX& vb, int cou
   const BorderedPattern& pattern = *shared_pattern;
   const bool bordered = pattern.n_base() > 0;  // M is then not block diagonal
   std::vector<double> K, Mv;
-  assemble_matrix(model, pattern, cols, res.q0, v, stiffness_terms(vb), K);
+  assemble_matrix(model, pattern, cols, res.q0, v, stiffness_terms(vb), K, &ws);
   const BlockMass bm = block_mass(model, res.q0);
   if (bordered) {
     MatrixTerms mt;
     mt.mass = 1.0;
-    assemble_matrix(model, pattern, cols, res.q0, v, mt, Mv);
+    assemble_matrix(model, pattern, cols, res.q0, v, mt, Mv, &ws);
   }
   VecX lambda;
   if (N <= dense_limit) {
@@ -478,7 +484,7 @@ ModesResult modes_of(const Model& model, const VecX& qb, const VecX& vb, int cou
 // The reduced model's modes: (Pᵀ K P, Pᵀ M P), dense (its size is the modes kept and the links kept
 // whole), shapes lifted to every rfe coordinate.
 ModesResult reduced_modes(const Model& model, const Reduction& red, const VecX& qb, const VecX& vb, int count,
-                          const std::vector<int>& free) {
+                          const std::vector<int>& free, const Parallelism& parallel) {
   const int nf = static_cast<int>(free.size()), N = red.rfe() + nf;
   if (std::set<int>(free.begin(), free.end()).size() != free.size()) throw std::invalid_argument("a joint is freed twice");
   for (int j : free)
@@ -491,17 +497,19 @@ ModesResult reduced_modes(const Model& model, const Reduction& red, const VecX& 
   ModesResult res;
   StaticOptions so;
   so.reduction = &red;
+  so.parallel = parallel;
   res.q0 = solve_static(model, qb, vb, TipLoads{}, so).q;
+  Workspace ws(model, parallel);
   VecX v = VecX::Zero(model.dof());
   if (vb.size()) model.joint_coords(v) = vb;
   std::vector<int> cols(model.m(), -1);
   for (int i = 0; i < nf; ++i) cols[free[i]] = model.flexible_dofs() + i;
   const BorderedPattern pattern(model, cols);
   std::vector<double> K, Mv;
-  assemble_matrix(model, pattern, cols, res.q0, v, stiffness_terms(vb), K);
+  assemble_matrix(model, pattern, cols, res.q0, v, stiffness_terms(vb), K, &ws);
   MatrixTerms mt;
   mt.mass = 1.0;
-  assemble_matrix(model, pattern, cols, res.q0, v, mt, Mv);
+  assemble_matrix(model, pattern, cols, res.q0, v, mt, Mv, &ws);
   const MatX Kr = MatX(red.reduce(pattern, K)), Mr = MatX(red.reduce(pattern, Mv));
   Eigen::GeneralizedSelfAdjointEigenSolver<MatX> es(Kr, Mr);
   if (es.info() != Eigen::Success) throw std::runtime_error("modal analysis: dense eigen-solver failed");

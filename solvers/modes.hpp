@@ -7,6 +7,7 @@
 // ones. Free joints without stiffness give rigid-body modes (ω = 0, kind Rigid).
 #include <string>
 
+#include "rfem/assembly/workspace.hpp"
 #include "rfem/core/model.hpp"
 
 namespace rfem {
@@ -32,9 +33,10 @@ constexpr double kUncertaintyTolerance = 1e-8;
 /// Lowest `count` modes. `vb` are the steady joint rates (empty or zero: no rotation).
 /// `free`: joints (0-based) that move with the modes instead of being held; each must carry no
 /// torque in the held equilibrium (else there is no equilibrium to linearise about).
-/// `dense_limit`: largest 6n + f solved densely. Throws std::invalid_argument for bad arguments.
+/// `dense_limit`: largest 6n + f solved densely. `parallel`: the threads of its kernels (statics,
+/// assembly, a reduced link's modes). Throws std::invalid_argument for bad arguments.
 ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, int count,
-                          int dense_limit = 600, const std::vector<int>& free = {});
+                          int dense_limit = 600, const std::vector<int>& free = {}, const Parallelism& parallel = {});
 
 /// Coordinates of an rfe a reduced link's modes span: x2, x3, φ1, φ2, φ3 (its axial x1 stays an
 /// unknown of its own: solvers/reduction.hpp says why).
@@ -58,7 +60,8 @@ struct LinkModes {
   VecX q0;           ///< the equilibrium, 6n, rfe by rfe
   std::vector<std::pair<int, int>> pairs;  ///< (i, j), from 1, of each derivative column after the modes
 };
-LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int derivatives = 0);
+LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int derivatives = 0,
+                     const Parallelism& parallel = {});
 
 /// A mode is rigid when ω² is below this fraction of the stiffest coordinate's K_ii / M_ii (the
 /// round-off level of a zero eigenvalue).

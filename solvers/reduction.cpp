@@ -8,12 +8,12 @@
 
 namespace rfem {
 
-Reduction::Reduction(const Model& model, const VecX& qb) : full_rfe_(model.flexible_dofs()) {
+Reduction::Reduction(const Model& model, const VecX& qb, const Parallelism& parallel) : full_rfe_(model.flexible_dofs()) {
   std::vector<char> reduced(full_rfe_, 0);
   for (size_t l = 0; l < model.links.size(); ++l) {
     const MountedLink& L = model.links[l];
     if (L.d.modes <= 0) continue;
-    LinkModes lm = link_modes(model, static_cast<int>(l), qb, L.d.modes, L.d.derivatives);
+    LinkModes lm = link_modes(model, static_cast<int>(l), qb, L.d.modes, L.d.derivatives, parallel);
     Link r;
     r.link = static_cast<int>(l);
     for (int k = 0; k < L.n(); ++k) {
@@ -43,9 +43,9 @@ Reduction::Reduction(const Model& model, const VecX& qb) : full_rfe_(model.flexi
   }
 }
 
-std::shared_ptr<const Reduction> Reduction::of(const Model& model, const VecX& qb) {
+std::shared_ptr<const Reduction> Reduction::of(const Model& model, const VecX& qb, const Parallelism& parallel) {
   for (const MountedLink& L : model.links)
-    if (L.d.modes > 0) return std::make_shared<const Reduction>(model, qb);
+    if (L.d.modes > 0) return std::make_shared<const Reduction>(model, qb, parallel);
   return nullptr;
 }
 

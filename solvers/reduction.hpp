@@ -22,6 +22,7 @@
 #include <Eigen/SparseCore>
 
 #include "rfem/assembly/pattern.hpp"
+#include "rfem/assembly/workspace.hpp"
 #include "rfem/core/model.hpp"
 
 namespace rfem {
@@ -44,12 +45,12 @@ class Reduction {
     std::vector<std::pair<int, int>> pairs;  ///< the modes (from 1) of each derivative column
   };
 
-  /// The reduction of every link with d.modes > 0, its modes taken at joint values qb. Throws
-  /// std::invalid_argument naming the link for modes larger than 6n, or a cut through a pair of
-  /// equal frequencies.
-  Reduction(const Model& model, const VecX& qb);
+  /// The reduction of every link with d.modes > 0, its modes taken at joint values qb on the
+  /// threads `parallel` allows (the caller's choice holds here too). Throws std::invalid_argument
+  /// naming the link for modes larger than 6n, or a cut through a pair of equal frequencies.
+  Reduction(const Model& model, const VecX& qb, const Parallelism& parallel = {});
   /// Null if no link of the model is reduced.
-  static std::shared_ptr<const Reduction> of(const Model& model, const VecX& qb);
+  static std::shared_ptr<const Reduction> of(const Model& model, const VecX& qb, const Parallelism& parallel = {});
 
   int full_rfe() const { return full_rfe_; }  ///< 6n
   int rfe() const { return rfe_; }            ///< reduced rfe unknowns

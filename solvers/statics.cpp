@@ -105,7 +105,7 @@ StaticResult solve_static(const Model& model, const VecX& qb, const VecX& vb, co
   const BorderedPattern& pattern = *shared_pattern;
   std::shared_ptr<const Reduction> own;  // reduced links: Newton on η, q = q0 + Φ η
   const Reduction* red = opts.reduction;
-  if (!red && (own = Reduction::of(model, qb))) red = own.get();
+  if (!red && (own = Reduction::of(model, qb, opts.parallel))) red = own.get();
   const int n6 = model.flexible_dofs(), nu = red ? red->rfe() : n6;
   // The chain solver (Cholesky: O(n), in place, no analysis) while the stiffness is positive
   // definite; CHOLMOD's LDLᵀ once it is not (a spinning link's centrifugal softening). CHOLMOD's

@@ -92,8 +92,11 @@ SimulationState SimulationState::unpack(const std::string& model, const std::vec
 
 std::string model_signature(const Model& model, const std::vector<JointInput>& inputs) {
   std::string s = "n=" + std::to_string(model.n()) + "; links=";
-  for (size_t l = 0; l < model.links.size(); ++l)
+  for (size_t l = 0; l < model.links.size(); ++l) {  // (a reduced link's state is over its own basis)
+    const Discretisation& d = model.links[l].d;
     s += (l ? "," : "") + model.links[l].name + ":" + std::to_string(model.links[l].n());
+    if (d.modes > 0) s += ":modes=" + std::to_string(d.modes) + ":derivatives=" + std::to_string(d.derivatives);
+  }
   s += "; joints=";
   const std::vector<std::string> kinds = input_kinds(inputs);
   for (int j = 0; j < model.m(); ++j)

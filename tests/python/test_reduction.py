@@ -184,3 +184,22 @@ def test_refine_over_modes_refuses_bad_series_in_one_line(tmp_path, args, words)
                         "-o", str(tmp_path / "x.h5")] + args, capture_output=True, text=True)
     assert r.returncode == 2 and words in r.stderr and r.stderr.count("\n") == 1, r.stderr
     assert not os.path.exists(tmp_path / "x.h5")
+
+
+def test_a_state_of_another_reduction_is_refused():
+    """A state holds η over its own basis: Kane's beam with 4 modes and the derivatives of the first
+    4 has 9 columns (5 of 10 derivatives add a shape), like 8 modes and the derivatives of the
+    first 2 (1 of 3), so a size check cannot tell them apart; the model's signature names each
+    reduced link's modes and derivatives, and the state is refused in one line. The same reduction
+    goes on from it."""
+    def kane(*overrides):
+        return rfem.load(case_path("kane_spinup.toml"), overrides=list(overrides))
+    mine, other = ("link.modes=4", "link.derivatives=4"), ("link.modes=8", "link.derivatives=2")
+    first = rfem.Simulation(kane(*mine), n=10, threads=1)
+    first.advance(0.05)
+    state = first.state()
+    assert rfem.Simulation(kane(*other), n=10, threads=1).state().pack().size == state.pack().size
+    with pytest.raises(ValueError, match="another model"):
+        rfem.Simulation(kane(*other), n=10, state=state, threads=1)
+    again = rfem.Simulation(kane(*mine), n=10, state=state, threads=1)
+    assert again.time == 0.05
