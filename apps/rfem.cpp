@@ -4,7 +4,6 @@
 #include <spdlog/spdlog.h>
 #include <fmt/core.h>
 
-#include <Eigen/Core>
 #include <cmath>
 #include <sstream>
 
@@ -205,8 +204,9 @@ int main(int argc, char** argv) {
     print_line(fmt::format("rfem: error: {} (rfem --help)", what));
     return 2;
   }
-  Eigen::setNbThreads(1);  // librfem parallelises itself (--threads goes to each call)
-  // and no call the program makes uses more than --threads, whether it is passed them or not
+  // librfem parallelises itself (--threads goes to each call; Eigen's products are serial,
+  // EIGEN_DONT_PARALLELIZE), and no call the program makes uses more than --threads, whether it is
+  // passed them or not.
   if (common.threads > 0) omp_set_num_threads(common.threads);
   spdlog::set_default_logger(spdlog::stderr_logger_mt("rfem"));
   spdlog::set_pattern("[%H:%M:%S.%e] %v");

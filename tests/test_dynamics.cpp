@@ -6,9 +6,12 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <filesystem>
+
 #include "rfem/assembly/dense_reference.hpp"
 #include "rfem/solvers/integrator.hpp"
 #include "rfem/solvers/newton_system.hpp"
+#include "rfem/solvers/reduction.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;
@@ -315,4 +318,32 @@ TEST(Dynamics, StaticInitialStateStartsInEquilibrium) {
   // Undeformed: the sag develops (mm) and the torques swing by a sizeable fraction.
   EXPECT_GT(dq_u, 1e-4);
   EXPECT_GT(dtau_u, 1e-2 * tau);
+}
+
+namespace {
+long process_threads() {  // the threads of this process now (Linux)
+  long n = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator("/proc/self/task")) ++n;
+  return n;
+}
+}  // namespace
+
+TEST(Dynamics, AReducedLinksSetupKeepsToTheCallersThreads) {
+  // A reduced link's modes and derivatives (statics, assembly, the differences of the static
+  // forces) run on the threads the caller's Parallelism allows: libgomp starts its workers at the
+  // first region with a team above one and keeps them, so one thread leaves the process's thread
+  // count as it was. The same setup with OpenMP's default team (two cores) starts them: what this
+  // test watches can fail. (ctest runs each test in a process of its own, with no team before.)
+  if (omp_get_max_threads() < 2 || !std::filesystem::exists("/proc/self/task")) GTEST_SKIP() << "one core, or no /proc";
+  const Case cs = read_case(test::source_path("cases/paper_deployment.toml"), {"link.modes=4", "link.derivatives=1"});
+  const Model model = build_model(cs, 300);  // (teams from 256 rfes on)
+  const VecX qb = VecX::Zero(model.m());
+  const long before = process_threads();
+  Parallelism one;
+  one.threads = 1;
+  const Reduction mine(model, qb, one);
+  EXPECT_EQ(process_threads(), before) << "the setup started threads with Parallelism::threads = 1";
+  const Reduction any(model, qb);
+  EXPECT_GT(process_threads(), before) << "OpenMP's default team started no thread: the check above cannot fail";
+  EXPECT_EQ(mine.rfe(), any.rfe());
 }
