@@ -54,7 +54,7 @@ bool NewtonSystem::setup(const VecX& q, const VecX& v, double h, Workspace& ws) 
       }
       base_rows_ = std::move(reduced);
     }
-    return reduced_->factorize(projection_->reduce(S_, team));
+    return reduced_->factorize(projection_->reduce(S_, team), reduction_->kept(), true, team);
   }
   solver_->set_threads(ws.parallel.team(model_->n()));
   return solver_->factorize(S_);
@@ -67,7 +67,7 @@ bool NewtonSystem::solve_mass(const VecX& q, const VecX& v, VecX& b, std::vector
   mt.mass = 1.0;
   assemble_matrices(*model_, *pattern_, base_col_, q, v, mt, values, {}, nullptr, &ws);
   ReducedFactor f;
-  if (!f.factorize(projection_->reduce(values))) return false;
+  if (!f.factorize(projection_->reduce(values), reduction_->kept())) return false;
   f.solve(b);
   return true;
 }
@@ -83,7 +83,7 @@ void NewtonSystem::set_joint_feedback(std::vector<double> kp, std::vector<double
 
 void NewtonSystem::solve(VecX& b, int threads) const {
   if (reduced_) {
-    reduced_->solve(b);
+    reduced_->solve(b, threads);
     return;
   }
   solver_->set_threads(threads);

@@ -264,12 +264,17 @@ const SparseMat& Projection::reduce(const std::vector<double>& values, int team)
       MatX& G = G_[p];
       G.resize(links[l].phi.cols(), W.cols());
       const long blocks = (W.cols() + kGramBlock - 1) / kGramBlock;
+      // Φ_lᵀ W_l is symmetric: its upper block triangle only (rows up to each block's last), then mirrored.
+      const bool symmetric = l == l2;
       for_team_items(blocks, team, [&](long b0, long b1) {
         for (long b = b0; b < b1; ++b) {
-          const long c0 = b * kGramBlock, w = std::min<long>(kGramBlock, W.cols() - c0);
-          G.middleCols(c0, w).noalias() = links[l].phi.transpose() * wb.middleCols(c0, w);
+          const long c0 = b * kGramBlock, w = std::min<long>(kGramBlock, W.cols() - c0), rows = symmetric ? c0 + w : G.rows();
+          G.block(0, c0, rows, w).noalias() = links[l].phi.leftCols(rows).transpose() * wb.middleCols(c0, w);
         }
       });
+      if (symmetric)
+        for (long c = 0; c < G.cols(); ++c)
+          for (long r = (c / kGramBlock + 1) * kGramBlock; r < G.rows(); ++r) G(r, c) = G(c, r);
     }
   double* out = R_.valuePtr();
   for_team_parts(static_cast<long>(source_.size()), team, [&](long b, long e) {
@@ -292,17 +297,81 @@ std::vector<std::string> Reduction::names(const Model& model, const std::vector<
   return out;
 }
 
-bool ReducedFactor::factorize(const SparseMat& S, bool definite) {
-  if (S.nonZeros() != nnz_ || S.rows() != size_) {
-    llt_.analyzePattern(S);
+bool ReducedFactor::factorize(const SparseMat& S, int kept, bool definite, int team) {
+  const int n = static_cast<int>(S.rows()), nb = n - kept;
+  if (S.nonZeros() != nnz_ || n != size_ || kept != kept_) {  // a new pattern: T's, analysed once
+    std::vector<Eigen::Triplet<double>> t;
+    for (int c = 0; c < kept; ++c)
+      for (SparseMat::InnerIterator it(S, c); it; ++it)
+        if (it.row() >= c && it.row() < kept) t.emplace_back(static_cast<int>(it.row()), c, 0.0);
+    T_.resize(kept, kept);
+    T_.setFromTriplets(t.begin(), t.end());
+    if (kept > 0) t_.analyzePattern(T_);
     nnz_ = S.nonZeros();
-    size_ = static_cast<int>(S.rows());
+    size_ = n;
+    kept_ = kept;
   }
-  llt_.factorize(S);
-  if (llt_.info() != Eigen::Success) return false;
-  return !definite || (llt_.vectorD().array() > 0.0).all();
+  // T's lower triangle and Bᵀ off S's columns (S holds both triangles; T_'s entries in S's order).
+  Bt_.setZero(nb, kept);
+  for (int c = 0; c < kept; ++c) {
+    double* tv = T_.valuePtr() + T_.outerIndexPtr()[c];
+    for (SparseMat::InnerIterator it(S, c); it; ++it) {
+      const int r = static_cast<int>(it.row());
+      if (r >= c && r < kept) *tv++ = it.value();
+      else if (r >= kept) Bt_(r - kept, c) = it.value();
+    }
+  }
+  schur_.resize(nb, nb);
+  for (int c = 0; c < nb; ++c)
+    for (SparseMat::InnerIterator it(S, kept + c); it; ++it)
+      if (it.row() >= kept) schur_(it.row() - kept, c) = it.value();
+  if (kept > 0) {
+    t_.factorize(T_);
+    if (t_.info() != Eigen::Success) return false;
+    if (definite && !(t_.vectorD().array() > 0.0).all()) return false;
+    // Yᵀ = (T⁻¹ B)ᵀ a border column at a time, then the Schur complement's upper triangle by rows.
+    Yt_.resize(nb, kept);
+    for_team_items(nb, team, [&](long b, long e) {
+      VecX y;
+      for (long i = b; i < e; ++i) {
+        y = t_.solve(Bt_.row(i).transpose());
+        Yt_.row(i) = y.transpose();
+      }
+    });
+    for_team_items(nb, team, [&](long b, long e) {
+      for (long i = b; i < e; ++i)
+        for (long j = i; j < nb; ++j) schur_(i, j) -= Bt_.row(i).dot(Yt_.row(j));
+    });
+    for (int i = 0; i < nb; ++i)
+      for (int j = 0; j < i; ++j) schur_(i, j) = schur_(j, i);
+    if (!schur_.allFinite()) return false;
+  }
+  if (nb > 0) {
+    s_.compute(schur_);
+    if (s_.info() != Eigen::Success) return false;
+    const VecX d = s_.vectorD();
+    if (definite ? !(d.array() > 0.0).all() : !(d.array() != 0.0).all()) return false;
+  }
+  return true;
 }
 
-void ReducedFactor::solve(VecX& b) const { b = llt_.solve(b); }
+void ReducedFactor::solve(VecX& b, int team) const {
+  const int kept = kept_, nb = size_ - kept_;
+  if (kept == 0) {
+    b = s_.solve(b);
+    return;
+  }
+  VecX u = t_.solve(b.head(kept));  // T⁻¹ b1
+  VecX x2 = b.tail(nb);
+  for_team_items(nb, team, [&](long s, long e) {  // b2 − Bᵀ T⁻¹ b1
+    for (long i = s; i < e; ++i) x2[i] -= Bt_.row(i).dot(u);
+  });
+  if (nb > 0) x2 = s_.solve(x2);
+  for_team_parts(kept, team, [&](long s, long e) {  // x1 = T⁻¹ b1 − Y x2, element by element
+    for (int j = 0; j < nb; ++j) u.segment(s, e - s) -= x2[j] * Yt_.row(j).segment(s, e - s).transpose();
+  });
+  b.head(kept) = u;
+  b.tail(nb) = x2;
+}
 
 }  // namespace rfem

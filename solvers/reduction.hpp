@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
@@ -54,6 +55,7 @@ class Reduction {
 
   int full_rfe() const { return full_rfe_; }  ///< 6n
   int rfe() const { return rfe_; }            ///< reduced rfe unknowns
+  int kept() const { return static_cast<int>(kept_.size()); }  ///< of them, the rfe coordinates kept (they come first)
   const std::vector<Link>& links() const { return links_; }
   /// P over 6n + k coordinates (k joints appended), as a sparse matrix.
   SparseMat projector(int k) const;
@@ -117,19 +119,30 @@ class Projection {
   std::vector<MatX> G_;         // Φ_lᵀ W_l' per link pair (l·links + l')
 };
 
-/// LDLᵀ factor of a reduced (sparse, symmetric) matrix, its ordering analysed once per pattern.
-/// `definite`: false unless positive definite (a Newton matrix); otherwise an indefinite matrix
-/// is factorised as CHOLMOD's LDLᵀ does for the full statics (a spinning link's stiffness before
-/// the centrifugal tension has built up).
+/// Factor of a reduced (sparse, symmetric) matrix S = [T B; Bᵀ D] split after its `kept` leading
+/// unknowns: T over the rfe coordinates kept (sparse: the x1 chain of a reduced link, the links kept
+/// whole), B and D dense over the modal coordinates and joints that border it. T by a sparse LDLᵀ
+/// (its ordering analysed once per pattern), then the Schur complement D − Bᵀ T⁻¹ B by a dense
+/// LDLᵀ; a solve is one sparse solve with T and two products with the border on the team (a sparse
+/// LDLᵀ of the whole S filled T's rows with the border and solved it serially: 13 solves a step,
+/// the second thread waiting; docs/performance.md, "Reduced links"). Each product's entries are
+/// sums in a fixed order: the same bits for any team. `definite`: false unless positive definite
+/// (a Newton matrix); otherwise an indefinite matrix is factorised as CHOLMOD's LDLᵀ does for the
+/// full statics (a spinning link's stiffness before the centrifugal tension has built up).
 class ReducedFactor {
  public:
-  bool factorize(const SparseMat& S, bool definite = true);
-  void solve(VecX& b) const;
+  bool factorize(const SparseMat& S, int kept, bool definite = true, int team = 1);
+  void solve(VecX& b, int team = 1) const;
 
  private:
-  Eigen::SimplicialLDLT<SparseMat, Eigen::Lower, Eigen::AMDOrdering<int>> llt_;
+  using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  Eigen::SimplicialLDLT<SparseMat, Eigen::Lower, Eigen::AMDOrdering<int>> t_;
+  SparseMat T_;       // S's kept block (its pattern kept between calls)
+  RowMat Bt_, Yt_;    // Bᵀ and (T⁻¹ B)ᵀ, border × kept
+  MatX schur_;        // D − Bᵀ T⁻¹ B
+  Eigen::LDLT<MatX> s_;
   long nnz_ = -1;
-  int size_ = -1;
+  int size_ = -1, kept_ = -1;
 };
 
 }  // namespace rfem

@@ -150,8 +150,8 @@ StaticResult solve_static(const Model& model, const VecX& qb, const VecX& vb, co
       assemble_matrix(model, pattern, held, q, v, terms, values, &ws);
       VecX dq = -r;
       if (red) {
-        if (!reduced.factorize(projection->reduce(values), false)) break;
-        reduced.solve(dq);
+        if (!reduced.factorize(projection->reduce(values), red->kept(), false, opts.parallel.team(n))) break;
+        reduced.solve(dq, opts.parallel.team(n));
       } else {
         if (!cholmod && !chain.factorize(values)) {  // not positive definite: LDLᵀ from now on
           cholmod = std::make_unique<CholmodSolver>(shared_pattern);
