@@ -128,6 +128,65 @@ struct EsdirkStepper::Impl {
       }
     });
   }
+  // Q, V of stage i from its acceleration α_i (Q = Q_k + (hγ)² α_i, V = V_k + hγ α_i).
+  void stage_values(int i, double hg) {
+    for_team_parts(u, eq.team(), [&](long b, long e) {
+      V.segment(b, e - b) = Vk.segment(b, e - b) + hg * alpha[i].segment(b, e - b);
+      Q.segment(b, e - b) = Qk.segment(b, e - b) + (hg * hg) * alpha[i].segment(b, e - b);
+    });
+  }
+  // Stage i's Newton iteration on α_i from its value, with the factorised S; true if converged.
+  // `diverged`: the increments grew (the caller restarts from the predictor).
+  bool newton_stage(int i, double ti, double hg, bool& diverged) {
+    double dn_prev = 0.0;
+    diverged = false;
+    for (int it = 0; it < max_newton; ++it) {
+      stage_values(i, hg);
+      Ps[i] = eq.residual(ti, Q.data(), V.data(), alpha[i].data(), r.data());
+      ++st.residual_evals;
+      ++st.newton_iters;
+      eq.solve_newton(r);  // −δα (a residual that is not finite gives a δα that is not)
+      // α_i −= δα with the increment's norm; a stage that is not finite is cut (the next attempt
+      // starts α_i afresh from its predictor).
+      const double dn = wmax_increment(r, hg, w, eq.team(), &alpha[i]);
+      if (!std::isfinite(dn)) {
+        nonfinite = true;
+        return false;
+      }
+      // Contraction rate θ; give up if it cannot make it within the iterations left. The first
+      // rate (predictor → first correction) is no guide: that correction removes the predictor's
+      // error in the stiff coordinates, after which the increments shrink fast (measured where the
+      // first rate had cut the step: the next increment 0.005–0.2 of the last; docs/performance.md,
+      // "Newton's first rate"). It ends the iteration only if the increment grew kFirstGrowth-fold,
+      // and declares nothing; the later rates decide.
+      bool judged = true;
+      if (it == 1 && dn >= 0.99 * dn_prev) {
+        if (dn >= kFirstGrowth * dn_prev) {
+          diverged = true;
+          return false;
+        }
+        judged = false;
+      } else if (it > 0) {
+        const double theta = dn / dn_prev;
+        if (theta >= 0.99) {
+          diverged = true;
+          return false;
+        }
+        eta = theta / (1.0 - theta);
+        if (it > 1 && std::pow(theta, max_newton - 1 - it) / (1.0 - theta) * dn > kNewtonTol) return false;
+      }
+      if ((judged && eta * dn <= kNewtonTol) || dn < 1e-12) {
+        // The power was evaluated before this last update: carry it to the converged stage.
+        r = -r;  // δα
+        const Power dP = eq.power_change(ti, V.data(), r, hg);
+        Ps[i].input += dP.input;
+        Ps[i].dissipation += dP.dissipation;
+        return true;
+      }
+      dn_prev = dn;
+    }
+    return false;
+  }
   RunStatus fail(const std::string& why) {
     char buf[200];
     std::snprintf(buf, sizeof buf, " at t = %.6g s (step %.3g s)", t, h);
@@ -255,11 +314,19 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
       const double hg = h * T.gamma;
       weights(q, v, nullptr, nullptr);
 
-      // The Newton matrix S(hγ) = M + hγ C + (hγ)² K at the step's start, every step: the base
-      // angles turn the border of M and the sde forces turn the geometric part of K fast enough
-      // that older matrices cost Newton failures (and accuracy) under force input.
+      // The Newton matrix S(hγ) = M + hγ C + (hγ)² K, every step: the base angles turn the border
+      // of M and the sde forces turn the geometric part of K fast enough that older matrices cost
+      // Newton failures (and accuracy) under force input. It is set up at the step's middle,
+      // predicted from (q, v, a), not at its start: the stages lie in [t, t + h], and a reduced
+      // link's modal derivatives, coupled to the modes quadratically, turn S's tangent by 10–20 %
+      // over a long step (docs/performance.md, "Newton's matrix at the stage"). (Q and V are free
+      // until the stages.)
       ++st.factorizations;
-      bool converged = eq.setup_newton(t, q.data(), v.data(), hg);
+      for_team_parts(u, eq.team(), [&](long b, long e) {
+        Q.segment(b, e - b) = q.segment(b, e - b) + (0.5 * h) * v.segment(b, e - b) + (0.125 * h * h) * a.segment(b, e - b);
+        V.segment(b, e - b) = v.segment(b, e - b) + (0.5 * h) * a.segment(b, e - b);
+      });
+      bool converged = eq.setup_newton(t + 0.5 * h, Q.data(), V.data(), hg);
 
       // Stages: α_0 = a_n (first same as last), then one Newton iteration per stage.
       Ps[0] = P;
@@ -275,51 +342,19 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
         }
         combine(Vk, v, cv.data(), Qk, Q, cq.data(), alpha, i, team);
         alpha[i] = alpha[i - 1];  // predictor (extrapolations measured no better)
-        double dn_prev = 0.0;
         eta = std::pow(std::max(eta, 1e-16), 0.8);
-        converged = false;
-        for (int it = 0; it < max_newton; ++it) {
-          for_team_parts(u, eq.team(), [&](long b, long e) {
-            V.segment(b, e - b) = Vk.segment(b, e - b) + hg * alpha[i].segment(b, e - b);
-            Q.segment(b, e - b) = Qk.segment(b, e - b) + (hg * hg) * alpha[i].segment(b, e - b);
-          });
-          Ps[i] = eq.residual(ti, Q.data(), V.data(), alpha[i].data(), r.data());
-          ++st.residual_evals;
-          ++st.newton_iters;
-          eq.solve_newton(r);  // −δα (a residual that is not finite gives a δα that is not)
-          // α_i −= δα with the increment's norm; a stage that is not finite is cut below (the
-          // next attempt starts α_i afresh from its predictor).
-          const double dn = wmax_increment(r, hg, w, eq.team(), &alpha[i]);
-          if (!std::isfinite(dn)) {
-            nonfinite = true;
-            break;
-          }
-          // Contraction rate θ; give up if it cannot make it within the iterations left. The first
-          // rate (predictor → first correction) is no guide: that correction removes the
-          // predictor's error in the stiff coordinates, after which the increments shrink fast
-          // (measured where the first rate had cut the step: the next increment 0.005–0.2 of the
-          // last; docs/performance.md, "Newton's first rate"). It ends the iteration only if the
-          // increment grew kFirstGrowth-fold, and declares nothing; the later rates decide.
-          bool judged = true;
-          if (it == 1 && dn >= 0.99 * dn_prev) {
-            if (dn >= kFirstGrowth * dn_prev) break;
-            judged = false;
-          } else if (it > 0) {
-            const double theta = dn / dn_prev;
-            if (theta >= 0.99) break;
-            eta = theta / (1.0 - theta);
-            if (it > 1 && std::pow(theta, max_newton - 1 - it) / (1.0 - theta) * dn > kNewtonTol) break;
-          }
-          if ((judged && eta * dn <= kNewtonTol) || dn < 1e-12) {
-            converged = true;
-            // The power was evaluated before this last update: carry it to the converged stage.
-            r = -r;  // δα
-            const Power dP = eq.power_change(ti, V.data(), r, hg);
-            Ps[i].input += dP.input;
-            Ps[i].dissipation += dP.dissipation;
-            break;
-          }
-          dn_prev = dn;
+        // A stage that does not converge with the matrix of the step's middle gets one more try
+        // with S set up at its own iterate (from there, or from the predictor if the iteration
+        // diverged) before the step is cut 4-fold, or a fixed step fails (docs/performance.md,
+        // "Newton's matrix at the stage").
+        bool diverged = false;
+        converged = newton_stage(i, ti, hg, diverged);
+        if (!converged && !nonfinite) {
+          if (diverged) alpha[i] = alpha[i - 1];
+          stage_values(i, hg);
+          ++st.factorizations;
+          eta = 1.0;
+          converged = eq.setup_newton(ti, Q.data(), V.data(), hg) && newton_stage(i, ti, hg, diverged);
         }
       }
       if (!converged) {  // with a fresh matrix: cut the step

@@ -211,9 +211,12 @@ TEST(Links, FrequenciesOfATreeConvergeAtSecondOrder) {
 TEST(Links, OneLinkAtTheEndOfTheChainIsAsBeforeTopologies) {
   // No regression: one flexible link at the end of a serial chain — the paper's
   // deployment (kinematic input, n = 6) and the same arm on a free bus — against values printed by
-  // rfem 4a88975, before links and joints could be mounted on one another. On the machine that made
-  // them they are equal to the last bit; the bound, 1e-6 of each series' peak, leaves room for other
-  // CPUs' round-off and the adaptive steps it may move, not for any change of the model.
+  // rfem 4a88975, before links and joints could be mounted on one another. The stored values carry
+  // the default tolerances' integration error: 6.6e-6 of a series' peak (paper) and 1.1e-6 (free
+  // bus) against the same runs at rtol 1e-12, atol 1e-14. A run of today carries its own, of the
+  // same size, and any change of the step control moves it within that (the Newton matrix at the
+  // step's middle: 1.7e-6); the bound, 2e-5 of each series' peak, is the two together with room,
+  // and far below what a change of the model moves (a mounting error: the whole motion).
   struct Expect {
     double t;
     std::array<double, 3> u, y;  // tip deflection; joint torques (paper) or base x, y, z (free bus)
@@ -252,6 +255,6 @@ TEST(Links, OneLinkAtTheEndOfTheChainIsAsBeforeTopologies) {
       }
     }
     RecordProperty(bus ? "free_bus_difference_over_peak" : "paper_difference_over_peak", fmt(worst));
-    EXPECT_LT(worst, 1e-6) << (bus ? "free bus" : "paper deployment");
+    EXPECT_LT(worst, 2e-5) << (bus ? "free bus" : "paper deployment");
   }
 }
