@@ -18,11 +18,12 @@ coordinate; the other five coordinates of the 60 rfes (300) become the m modal a
    the energy balance (the work of the joint torques against T + V: the Galerkin projection
    conserves what the full model does).
 Steps and wall times vary with the machine and the build: they are on lines starting with "#".
-Measured on the project's two-core machine (one thread): force run 5 690 steps, 1.2 s (full);
-2 251, 0.6 s (m = 4); 3 766, 1.0 s (m = 8); 4 958, 1.4 s (m = 16); 4 182, 1.8 s (m = 8 with the
-derivatives) — at n = 60 a reduced step costs about what a full one does (the full residual is still
-evaluated, and the projection is added), and the coupled modes of the kept shapes reach tens of Hz:
-bench/reduction_bench.py measures n = 1 000.
+Measured on the project's two-core machine (one thread), at the default tolerances: force run
+5 677 steps, 1.1 s (full); 2 251, 0.5 s (m = 4); 3 755, 0.9 s (m = 8); 4 974, 1.3 s (m = 16); 4 160,
+1.4 s (m = 8 with the derivatives) — at n = 60 a reduced step costs about what a full one does (the
+full residual is still evaluated, and the projection is added), and the coupled modes of the kept
+shapes reach tens of Hz. bench/reduction_bench.py measures n = 1 000, where at atol 1e-8 the force
+run with the derivatives takes 1.47× the full kinematic run (README, "Reduced links").
 
     PYTHONPATH=build/python /usr/bin/python3 examples/ex15_reduced_force.py        (~8 s)
 """
