@@ -361,17 +361,17 @@ void ReducedFactor::solve(VecX& b, int team) const {
     b = s_.solve(b);
     return;
   }
-  VecX u = t_.solve(b.head(kept));  // T⁻¹ b1
-  VecX x2 = b.tail(nb);
+  // (into b itself: 12–13 solves a step, no vector allocated)
+  auto x1 = b.head(kept);
+  auto x2 = b.tail(nb);
+  x1 = t_.solve(x1);  // T⁻¹ b1 (a sparse LDLᵀ solves in place)
   for_team_items(nb, team, [&](long s, long e) {  // b2 − Bᵀ T⁻¹ b1
-    for (long i = s; i < e; ++i) x2[i] -= Bt_.row(i).dot(u);
+    for (long i = s; i < e; ++i) x2[i] -= Bt_.row(i).dot(x1);
   });
-  if (nb > 0) x2 = s_.solve(x2);
+  if (nb > 0) s_.solveInPlace(x2);
   for_team_parts(kept, team, [&](long s, long e) {  // x1 = T⁻¹ b1 − Y x2, element by element
-    for (int j = 0; j < nb; ++j) u.segment(s, e - s) -= x2[j] * Yt_.row(j).segment(s, e - s).transpose();
+    for (int j = 0; j < nb; ++j) x1.segment(s, e - s) -= x2[j] * Yt_.row(j).segment(s, e - s).transpose();
   });
-  b.head(kept) = u;
-  b.tail(nb) = x2;
 }
 
 }  // namespace rfem
