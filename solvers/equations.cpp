@@ -80,7 +80,10 @@ void EquationsOfMotion::expand(double t, const double* qu, const double* vu, con
     qf_.resize(U);
     vf_.resize(U);
     af_.resize(U);
-    reduction_->lift_state(qu, vu, au, qf_.data(), vf_.data(), af_.data(), k, team());
+    if (in_stage_ && au)
+      reduction_->lift_stage(qu, vu, au, qkf_.data(), vkf_.data(), stage_hg_, qf_.data(), vf_.data(), af_.data(), k, team());
+    else
+      reduction_->lift_state(qu, vu, au, qf_.data(), vf_.data(), af_.data(), k, team());
     qu = qf_.data();
     vu = vf_.data();
     au = au ? af_.data() : nullptr;
@@ -135,6 +138,26 @@ Power EquationsOfMotion::residual(double t, const double* qu, const double* vu, 
     if (base_col_[j] >= 0) full[base_col_[j]] -= tau[j];
   if (reduction_) reduction_->project(full, r, u - n6, team());  // Galerkin: r_η = Φᵀ r_l
   return p;
+}
+
+void EquationsOfMotion::begin_stage(const double* Qk, const double* Vk, double hg) {
+  RFEM_CHECK_ARGUMENT(unknowns() == 0 || (Qk && Vk), "Qk and Vk must point to unknowns() values");
+  stage_hg_ = hg;
+  if (!reduction_) return;
+  const int U = static_cast<int>(unknown_.size()), k = U - model_->flexible_dofs();
+  qkf_.resize(U);
+  vkf_.resize(U);
+  reduction_->lift_state(Qk, Vk, nullptr, qkf_.data(), vkf_.data(), nullptr, k, team());
+}
+
+Power EquationsOfMotion::stage_residual(double t, const double* Q, const double* V, const double* A, double* r) {
+  RFEM_CHECK_ARGUMENT(!reduction_ || qkf_.size() == static_cast<long>(unknown_.size()), "stage_residual before begin_stage");
+  struct Stage {  // (reset on every exit)
+    bool& on;
+    explicit Stage(bool& b) : on(b) { on = true; }
+    ~Stage() { on = false; }
+  } stage(in_stage_);
+  return residual(t, Q, V, A, r);
 }
 
 Power EquationsOfMotion::forces(double t, const double* qu, const double* vu, const double* au, VecX& tau) {

@@ -77,6 +77,12 @@ class EquationsOfMotion {
   Power forces(double t, const double* qu, const double* vu, const double* au, VecX& tau);
   /// r_u at (t, q_u, v_u, a_u); returns the power flows of that state.
   Power residual(double t, const double* qu, const double* vu, const double* au, double* r);
+  /// An ESDIRK stage's states Q = Qk + (hγ)² A, V = Vk + hγ A (A its accelerations): begin_stage
+  /// lifts Qk and Vk of a reduced model once, and stage_residual then lifts A alone (one pass over
+  /// the modes instead of three a residual; Reduction::lift_stage). stage_residual is residual(t, Q,
+  /// V, A, r) to round-off (exactly, without a reduced link); Q and V are the integrator's own.
+  void begin_stage(const double* Qk, const double* Vk, double hg);
+  Power stage_residual(double t, const double* Q, const double* V, const double* A, double* r);
   /// First-order change of a state's power flows when its accelerations move by δa_u at fixed
   /// Q_u = Q + (hγ)² δa, V_u = V + hγ δa (the last Newton update of an ESDIRK stage): required
   /// torques change by the mass rows M_bu δa, velocities by hγ δa, damping power by 2 Vᵀ C hγ δa.
@@ -132,6 +138,9 @@ class EquationsOfMotion {
   int nu_ = 0;
   std::vector<int> ubase_col_;  // base_col_ among the (reduced) unknowns
   VecX qf_, vf_, af_, rf_;      // reduced: the full unknowns' values
+  VecX qkf_, vkf_;              // reduced: the stage's Qk, Vk lifted (begin_stage)
+  double stage_hg_ = 0.0;
+  bool in_stage_ = false;       // expand lifts by lift_stage (inside stage_residual)
   std::unique_ptr<NewtonSystem> newton_;
   std::vector<double> mass_values_;
   VecX q_, v_, a_, F_;

@@ -142,7 +142,7 @@ struct EsdirkStepper::Impl {
     diverged = false;
     for (int it = 0; it < max_newton; ++it) {
       stage_values(i, hg);
-      Ps[i] = eq.residual(ti, Q.data(), V.data(), alpha[i].data(), r.data());
+      Ps[i] = eq.stage_residual(ti, Q.data(), V.data(), alpha[i].data(), r.data());
       ++st.residual_evals;
       ++st.newton_iters;
       eq.solve_newton(r);  // −δα (a residual that is not finite gives a δα that is not)
@@ -341,6 +341,7 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
           cq[j] = h * h * T.AA(i, j);
         }
         combine(Vk, v, cv.data(), Qk, Q, cq.data(), alpha, i, team);
+        eq.begin_stage(Qk.data(), Vk.data(), hg);
         alpha[i] = alpha[i - 1];  // predictor (extrapolations measured no better)
         eta = std::pow(std::max(eta, 1e-16), 0.8);
         // A stage that does not converge with the matrix of the step's middle gets one more try

@@ -77,6 +77,26 @@ void Reduction::lift(const double* x, double* xf, int k, bool positions, int tea
   for (int j = 0; j < k; ++j) xf[full_rfe_ + j] = x[rfe_ + j];
 }
 
+namespace {
+// Φ_l's rows of rfes [b, e) times `cols` (1–3) vectors η (reduced, at the link's first column) into
+// out (5(e − b) rows per vector, one after the other): each entry a dot product of a row of Φ_l
+// (row-major, the copy the projections read: one copy of Φ stays in the caches) with η (the same
+// bits for any part and team).
+void phi_times(const Reduction::Link& r, long b, long e, const double* const* x, int cols, double* out) {
+  const long rows = kModalAxes * (e - b), m = r.phi_rows.cols();
+  for (int c = 0; c < cols; ++c) {
+    const Eigen::Map<const VecX> eta(x[c] + r.first, m);
+    for (long i = 0; i < rows; ++i) out[c * rows + i] = r.phi_rows.row(kModalAxes * b + i).dot(eta.transpose());
+  }
+}
+// A thread's scratch for phi_times, kept between calls (grown once: no allocation per residual).
+double* scratch(size_t n) {
+  thread_local std::vector<double> s;
+  if (s.size() < n) s.resize(n);
+  return s.data();
+}
+}  // namespace
+
 void Reduction::lift_state(const double* q, const double* v, const double* a, double* qf, double* vf, double* af, int k,
                            int team) const {
   const int cols = a ? 3 : 2;
@@ -87,25 +107,51 @@ void Reduction::lift_state(const double* q, const double* v, const double* a, do
       for (int c = 0; c < cols; ++c) xf[c][kept_[i]] = x[c][i];
   });
   for (const Link& r : links_) {
-    const long m = r.phi.cols();
-    MatX eta(m, cols);  // η of q, v, a side by side: each row of Φ read once
-    for (int c = 0; c < cols; ++c) eta.col(c) = Eigen::Map<const VecX>(x[c] + r.first, m);
     for_team_parts(static_cast<long>(r.rfe.size()), team, [&](long b, long end) {
-      // This part's rows, each entry a dot product of a row of Φ with η (coefficient by coefficient:
-      // the same bits for any part and team; a blocked product packed Φ's rows anew at every
-      // residual, 7 % of a reduced run).
-      MatX part(kModalAxes * (end - b), cols);
-      part.noalias() = r.phi_rows.middleRows(kModalAxes * b, kModalAxes * (end - b)).lazyProduct(eta);
+      const long rows = kModalAxes * (end - b);
+      double* part = scratch(static_cast<size_t>(cols * rows));
+      phi_times(r, b, end, x, cols, part);
       for (long e = b; e < end; ++e)
         for (int ax = 0; ax < kModalAxes; ++ax) {
           const long at = r.rfe[e] + 1 + ax, row = kModalAxes * (e - b) + ax;
-          xf[0][at] = part(row, 0) + r.q0[6 * e + 1 + ax];
-          for (int c = 1; c < cols; ++c) xf[c][at] = part(row, c);
+          xf[0][at] = part[row] + r.q0[6 * e + 1 + ax];
+          for (int c = 1; c < cols; ++c) xf[c][at] = part[c * rows + row];
         }
     });
   }
   for (int j = 0; j < k; ++j)
     for (int c = 0; c < cols; ++c) xf[c][full_rfe_ + j] = x[c][rfe_ + j];
+}
+
+void Reduction::lift_stage(const double* Q, const double* V, const double* A, const double* qk, const double* vk, double hg,
+                           double* qf, double* vf, double* af, int k, int team) const {
+  const double hg2 = hg * hg;
+  for_team_parts(static_cast<long>(kept_.size()), team, [&](long b, long e) {
+    for (long i = b; i < e; ++i) {
+      qf[kept_[i]] = Q[i];
+      vf[kept_[i]] = V[i];
+      af[kept_[i]] = A[i];
+    }
+  });
+  for (const Link& r : links_) {
+    for_team_parts(static_cast<long>(r.rfe.size()), team, [&](long b, long end) {
+      double* part = scratch(static_cast<size_t>(kModalAxes * (end - b)));
+      phi_times(r, b, end, &A, 1, part);
+      for (long e = b; e < end; ++e)
+        for (int ax = 0; ax < kModalAxes; ++ax) {
+          const long at = r.rfe[e] + 1 + ax;
+          const double d = part[static_cast<size_t>(kModalAxes * (e - b) + ax)];
+          af[at] = d;
+          vf[at] = vk[at] + hg * d;
+          qf[at] = qk[at] + hg2 * d;
+        }
+    });
+  }
+  for (int j = 0; j < k; ++j) {
+    qf[full_rfe_ + j] = Q[rfe_ + j];
+    vf[full_rfe_ + j] = V[rfe_ + j];
+    af[full_rfe_ + j] = A[rfe_ + j];
+  }
 }
 
 namespace {
@@ -213,8 +259,8 @@ Projection::Projection(const Reduction& red, const BorderedPattern& pattern) : r
     for (int l = 0; l < L; ++l)
       if (to[r] >= 0 && kept_link[static_cast<size_t>(r) * L + l])
         for (int c = 0; c < links[l].phi.cols(); ++c) {
-          add(to[r], links[l].first + c, Source{Source::W, l, r, c});
-          add(links[l].first + c, to[r], Source{Source::W, l, r, c});  // (S symmetric)
+          add(to[r], links[l].first + c, Source{Source::W, l, to[r], c});
+          add(links[l].first + c, to[r], Source{Source::W, l, to[r], c});  // (S symmetric)
         }
   for (int l = 0; l < L; ++l)
     for (int l2 = 0; l2 < L; ++l2)
@@ -225,13 +271,33 @@ Projection::Projection(const Reduction& red, const BorderedPattern& pattern) : r
   R_.setFromTriplets(rt.begin(), rt.end());  // (each entry once)
   source_.resize(static_cast<size_t>(R_.nonZeros()));
   for (long k = 0; k < R_.nonZeros(); ++k) source_[static_cast<size_t>(k)] = src[static_cast<size_t>(R_.valuePtr()[k])];
+  // W's rows: a kept coordinate's at its reduced index (to), link l's lateral ones after every
+  // reduced rfe unknown and joint (at nr), in Φ_l's row order.
+  w_row_.assign(static_cast<size_t>(n), -1);
+  lateral_first_.assign(static_cast<size_t>(L), 0);
+  for (int i = 0; i < n; ++i)
+    if (to[i] >= 0) w_row_[static_cast<size_t>(i)] = to[i];
+  int w_rows = nr;
+  for (int l = 0; l < L; w_rows += static_cast<int>(links[l].phi_rows.rows()), ++l) {
+    lateral_first_[static_cast<size_t>(l)] = w_rows;
+    for (int i = 0; i < n; ++i)
+      if (link_of_[i] == l) w_row_[static_cast<size_t>(i)] = w_rows + phi_row_[i];
+  }
+  lat_ptr_.assign(static_cast<size_t>(n) + 1, 0);
+  for (int c = 0; c < n; ++c) {
+    for (long k = S_.outerIndexPtr()[c]; k < S_.outerIndexPtr()[c + 1]; ++k) {
+      const int j = S_.innerIndexPtr()[k];
+      if (link_of_[j] >= 0) lat_.push_back(Lateral{k, link_of_[j], phi_row_[j]});
+    }
+    lat_ptr_[static_cast<size_t>(c) + 1] = static_cast<long>(lat_.size());
+  }
   W_.resize(static_cast<size_t>(L));
-  for (int l = 0; l < L; ++l) W_[static_cast<size_t>(l)].resize(S_.rows(), links[l].phi.cols());
-  wb_.resize(static_cast<size_t>(L * L));
+  for (int l = 0; l < L; ++l) W_[static_cast<size_t>(l)].setZero(w_rows, links[l].phi.cols());  // (the η rows stay 0)
   G_.resize(static_cast<size_t>(L * L));
 }
 
 namespace {
+constexpr int kWBlock = 8;     // columns of W = S Φ summed in registers
 constexpr int kGramBlock = 8;  // columns of Φ_lᵀ W_l' per product (fixed: each entry's sum is the same for any team)
 }
 
@@ -243,24 +309,45 @@ const SparseMat& Projection::reduce(const std::vector<double>& values, int team)
   for_team_parts(static_cast<long>(slot_.size()), team, [&](long b, long e) {
     for (long k = b; k < e; ++k) v[k] = values[static_cast<size_t>(slot_[k])];
   });
-  // W_l = S Φ_l row by row: row i from S's column i (S is symmetric), its lateral entries.
+  // W_l = S Φ_l row by row: row i from S's column i (S is symmetric), its lateral entries (listed
+  // once: lat_), the rows of Φ_l summed in S's order.
+  // W's rows are the full coordinates reordered (w_row_): kept ones, then each link's lateral rows
+  // in Φ's order, so Φ_lᵀ W_l' reads W in place.
   for_team_parts(n, team, [&](long b, long e) {
-    for (int l = 0; l < L; ++l) W_[static_cast<size_t>(l)].middleRows(b, e - b).setZero();
-    for (long i = b; i < e; ++i)
-      for (SparseMat::InnerIterator it(S_, i); it; ++it) {
-        const int j = static_cast<int>(it.row()), l = link_of_[j];
-        if (l >= 0) W_[static_cast<size_t>(l)].row(i) += it.value() * links[l].phi_rows.row(phi_row_[j]);
+    for (long i = b; i < e; ++i) {
+      for (int l = 0; l < L; ++l) W_[static_cast<size_t>(l)].row(w_row_[i]).setZero();
+      for (long p = lat_ptr_[i], p1 = lat_ptr_[i + 1]; p < p1;) {
+        const int l = lat_[static_cast<size_t>(p)].link;
+        long q = p;  // [p, q): link l's entries
+        while (q < p1 && lat_[static_cast<size_t>(q)].link == l) ++q;
+        const long m = links[l].phi_rows.cols();
+        const double* phi = links[l].phi_rows.data();
+        double* w = W_[static_cast<size_t>(l)].row(w_row_[i]).data();
+        // Eight columns at a time summed in registers (adding each row of Φ to W's row in memory
+        // waited on the store before: 2× slower).
+        long c = 0;
+        for (; c + kWBlock <= m; c += kWBlock) {
+          Eigen::Array<double, kWBlock, 1> acc = Eigen::Array<double, kWBlock, 1>::Zero();
+          for (long t = p; t < q; ++t) {
+            const Lateral& x = lat_[static_cast<size_t>(t)];
+            acc += v[x.value] * Eigen::Map<const Eigen::Array<double, kWBlock, 1>>(phi + x.phi_row * m + c);
+          }
+          Eigen::Map<Eigen::Array<double, kWBlock, 1>>(w + c) += acc;
+        }
+        for (; c < m; ++c) {
+          double acc = 0.0;
+          for (long t = p; t < q; ++t) acc += v[lat_[static_cast<size_t>(t)].value] * phi[lat_[static_cast<size_t>(t)].phi_row * m + c];
+          w[c] += acc;
+        }
+        p = q;
       }
+    }
   });
-  for (int l = 0; l < L; ++l)  // the lateral rows of each link, then Φ_lᵀ W_l' in column blocks
+  for (int l = 0; l < L; ++l)  // Φ_lᵀ W_l' in column blocks, W_l' at link l's lateral rows
     for (int l2 = 0; l2 < L; ++l2) {
       const size_t p = static_cast<size_t>(l * L + l2);
       const RowMat& W = W_[static_cast<size_t>(l2)];
-      RowMat& wb = wb_[p];
-      wb.resize(links[l].phi.rows(), W.cols());
-      for_team_parts(static_cast<long>(links[l].rfe.size()), team, [&](long b, long e) {
-        for (long k = b; k < e; ++k) wb.middleRows<kModalAxes>(kModalAxes * k) = W.middleRows<kModalAxes>(links[l].rfe[k] + 1);
-      });
+      const auto wb = W.middleRows(lateral_first_[static_cast<size_t>(l)], links[l].phi_rows.rows());
       MatX& G = G_[p];
       G.resize(links[l].phi.cols(), W.cols());
       const long blocks = (W.cols() + kGramBlock - 1) / kGramBlock;
@@ -269,7 +356,7 @@ const SparseMat& Projection::reduce(const std::vector<double>& values, int team)
       for_team_items(blocks, team, [&](long b0, long b1) {
         for (long b = b0; b < b1; ++b) {
           const long c0 = b * kGramBlock, w = std::min<long>(kGramBlock, W.cols() - c0), rows = symmetric ? c0 + w : G.rows();
-          G.block(0, c0, rows, w).noalias() = links[l].phi.leftCols(rows).transpose() * wb.middleCols(c0, w);
+          G.block(0, c0, rows, w).noalias() = links[l].phi_rows.leftCols(rows).transpose() * wb.middleCols(c0, w);
         }
       });
       if (symmetric)

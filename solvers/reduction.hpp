@@ -65,6 +65,11 @@ class Reduction {
   /// lift of positions q (with q0), rates v and accelerations a (a may be null) in one pass over Φ.
   void lift_state(const double* q, const double* v, const double* a, double* qf, double* vf, double* af, int k,
                   int team = 1) const;
+  /// lift_state of an ESDIRK stage's Q = Qk + (hγ)² A, V = Vk + hγ A from Qk, Vk lifted once (qk, vk:
+  /// lift_state's qf, vf of them) and A alone: one pass over Φ instead of three. The kept and joint
+  /// coordinates are Q's, V's, A's; the reduced links' lateral ones equal lift_state's to round-off.
+  void lift_stage(const double* Q, const double* V, const double* A, const double* qk, const double* vk, double hg,
+                  double* qf, double* vf, double* af, int k, int team = 1) const;
   /// r = Pᵀ r_full; on `team` threads (Φᵀ r summed over fixed blocks of rfes in order: the same
   /// bits for any team).
   void project(const double* r_full, double* r, int k, int team = 1) const;
@@ -114,8 +119,15 @@ class Projection {
   using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   std::vector<int> link_of_;    // per full coordinate: its reduced link (−1: kept)
   std::vector<int> phi_row_;    // per full coordinate of a reduced link: its row of Φ_l
-  std::vector<RowMat> W_;       // S Φ_l over every full row (row i from S's column i: S is symmetric)
-  std::vector<RowMat> wb_;      // W_l' at link l's lateral rows, per link pair
+  struct Lateral {     // an entry of S in a reduced link's lateral row
+    long value;        // its index in S_'s values
+    int link, phi_row; // the link and the row of Φ_l
+  };
+  std::vector<long> lat_ptr_;   // column i's lateral entries: lat_[lat_ptr_[i] … lat_ptr_[i + 1])
+  std::vector<Lateral> lat_;
+  std::vector<RowMat> W_;       // S Φ_l over every full row (row i from S's column i: S is symmetric; rows by w_row_)
+  std::vector<int> w_row_;      // per full coordinate: its row of W_l (kept ones first, then each link's lateral rows)
+  std::vector<int> lateral_first_;  // per link: W's row of its first lateral coordinate
   std::vector<MatX> G_;         // Φ_lᵀ W_l' per link pair (l·links + l')
 };
 
