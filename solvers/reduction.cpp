@@ -102,12 +102,12 @@ void Reduction::lift_state(const double* q, const double* v, const double* a, do
   const int cols = a ? 3 : 2;
   const double* x[3] = {q, v, a};
   double* xf[3] = {qf, vf, af};
-  for_team_parts(static_cast<long>(kept_.size()), team, [&](long b, long e) {
-    for (long i = b; i < e; ++i)
+  for_team_threads(team, [&](int t, int T) {  // (one region: kept coordinates, then each link's rows)
+    const long nk = static_cast<long>(kept_.size());
+    for (long i = team_part(nk, t, T); i < team_part(nk, t + 1, T); ++i)
       for (int c = 0; c < cols; ++c) xf[c][kept_[i]] = x[c][i];
-  });
-  for (const Link& r : links_) {
-    for_team_parts(static_cast<long>(r.rfe.size()), team, [&](long b, long end) {
+    for (const Link& r : links_) {
+      const long n = static_cast<long>(r.rfe.size()), b = team_part(n, t, T), end = team_part(n, t + 1, T);
       const long rows = kModalAxes * (end - b);
       double* part = scratch(static_cast<size_t>(cols * rows));
       phi_times(r, b, end, x, cols, part);
@@ -117,8 +117,8 @@ void Reduction::lift_state(const double* q, const double* v, const double* a, do
           xf[0][at] = part[row] + r.q0[6 * e + 1 + ax];
           for (int c = 1; c < cols; ++c) xf[c][at] = part[c * rows + row];
         }
-    });
-  }
+    }
+  });
   for (int j = 0; j < k; ++j)
     for (int c = 0; c < cols; ++c) xf[c][full_rfe_ + j] = x[c][rfe_ + j];
 }
@@ -126,15 +126,15 @@ void Reduction::lift_state(const double* q, const double* v, const double* a, do
 void Reduction::lift_stage(const double* Q, const double* V, const double* A, const double* qk, const double* vk, double hg,
                            double* qf, double* vf, double* af, int k, int team) const {
   const double hg2 = hg * hg;
-  for_team_parts(static_cast<long>(kept_.size()), team, [&](long b, long e) {
-    for (long i = b; i < e; ++i) {
+  for_team_threads(team, [&](int t, int T) {  // (one region: kept coordinates, then each link's rows)
+    const long nk = static_cast<long>(kept_.size());
+    for (long i = team_part(nk, t, T); i < team_part(nk, t + 1, T); ++i) {
       qf[kept_[i]] = Q[i];
       vf[kept_[i]] = V[i];
       af[kept_[i]] = A[i];
     }
-  });
-  for (const Link& r : links_) {
-    for_team_parts(static_cast<long>(r.rfe.size()), team, [&](long b, long end) {
+    for (const Link& r : links_) {
+      const long n = static_cast<long>(r.rfe.size()), b = team_part(n, t, T), end = team_part(n, t + 1, T);
       double* part = scratch(static_cast<size_t>(kModalAxes * (end - b)));
       phi_times(r, b, end, &A, 1, part);
       for (long e = b; e < end; ++e)
@@ -145,8 +145,8 @@ void Reduction::lift_stage(const double* Q, const double* V, const double* A, co
           vf[at] = vk[at] + hg * d;
           qf[at] = qk[at] + hg2 * d;
         }
-    });
-  }
+    }
+  });
   for (int j = 0; j < k; ++j) {
     qf[full_rfe_ + j] = Q[rfe_ + j];
     vf[full_rfe_ + j] = V[rfe_ + j];
@@ -159,25 +159,28 @@ constexpr long kProjectBlock = 64;  // rfes per partial sum of Φᵀ r (fixed: t
 }
 
 void Reduction::project(const double* rf, double* r, int k, int team) const {
-  for_team_parts(static_cast<long>(kept_.size()), team, [&](long b, long e) {
-    for (long i = b; i < e; ++i) r[i] = rf[kept_[i]];
-  });
-  for (const Link& l : links_) {
-    const long n = static_cast<long>(l.rfe.size()), blocks = (n + kProjectBlock - 1) / kProjectBlock;
-    const long m = l.phi.cols();
-    MatX partial(m, blocks);  // column b: block b's Φᵀ r
-    for_team_items(blocks, team, [&](long b0, long b1) {
-      VecX lat(kModalAxes * kProjectBlock);
-      for (long b = b0; b < b1; ++b) {
+  std::vector<MatX> partial(links_.size());  // link l's column b: its block b's Φᵀ r
+  for (size_t l = 0; l < links_.size(); ++l)
+    partial[l].resize(links_[l].phi.cols(), (static_cast<long>(links_[l].rfe.size()) + kProjectBlock - 1) / kProjectBlock);
+  for_team_threads(team, [&](int t, int T) {  // (one region: kept coordinates, then each link's blocks)
+    const long nk = static_cast<long>(kept_.size());
+    for (long i = team_part(nk, t, T); i < team_part(nk, t + 1, T); ++i) r[i] = rf[kept_[i]];
+    for (size_t li = 0; li < links_.size(); ++li) {
+      const Link& l = links_[li];
+      const long n = static_cast<long>(l.rfe.size()), blocks = partial[li].cols();
+      Eigen::Map<VecX> lat(scratch(kModalAxes * kProjectBlock), kModalAxes * kProjectBlock);
+      for (long b = blocks * t / T; b < blocks * (t + 1) / T; ++b) {
         const long e0 = b * kProjectBlock, len = std::min(n, e0 + kProjectBlock) - e0;
         for (long e = 0; e < len; ++e)
           for (int a = 0; a < kModalAxes; ++a) lat[kModalAxes * e + a] = rf[l.rfe[e0 + e] + 1 + a];
-        partial.col(b).noalias() = l.phi_rows.middleRows(kModalAxes * e0, kModalAxes * len).transpose() * lat.head(kModalAxes * len);
+        partial[li].col(b).noalias() = l.phi_rows.middleRows(kModalAxes * e0, kModalAxes * len).transpose() * lat.head(kModalAxes * len);
       }
-    });
-    Eigen::Map<VecX> out(r + l.first, m);
+    }
+  });
+  for (size_t li = 0; li < links_.size(); ++li) {
+    Eigen::Map<VecX> out(r + links_[li].first, links_[li].phi.cols());
     out.setZero();
-    for (long b = 0; b < blocks; ++b) out += partial.col(b);
+    for (long b = 0; b < partial[li].cols(); ++b) out += partial[li].col(b);
   }
   for (int j = 0; j < k; ++j) r[rfe_ + j] = rf[full_rfe_ + j];
 }
@@ -298,6 +301,7 @@ Projection::Projection(const Reduction& red, const BorderedPattern& pattern) : r
 
 namespace {
 constexpr int kWBlock = 8;     // columns of W = S Φ summed in registers
+constexpr int kSweeps = 4;     // border columns of T⁻¹ B swept together
 constexpr int kGramBlock = 8;  // columns of Φ_lᵀ W_l' per product (fixed: each entry's sum is the same for any team)
 }
 
@@ -333,6 +337,14 @@ const SparseMat& Projection::reduce(const std::vector<double>& values, int team)
             acc += v[x.value] * Eigen::Map<const Eigen::Array<double, kWBlock, 1>>(phi + x.phi_row * m + c);
           }
           Eigen::Map<Eigen::Array<double, kWBlock, 1>>(w + c) += acc;
+        }
+        for (; c + 2 <= m; c += 2) {
+          Eigen::Array2d acc = Eigen::Array2d::Zero();
+          for (long t = p; t < q; ++t) {
+            const Lateral& x = lat_[static_cast<size_t>(t)];
+            acc += v[x.value] * Eigen::Map<const Eigen::Array2d>(phi + x.phi_row * m + c);
+          }
+          Eigen::Map<Eigen::Array2d>(w + c) += acc;
         }
         for (; c < m; ++c) {
           double acc = 0.0;
@@ -393,7 +405,16 @@ bool ReducedFactor::factorize(const SparseMat& S, int kept, bool definite, int t
         if (it.row() >= c && it.row() < kept) t.emplace_back(static_cast<int>(it.row()), c, 0.0);
     T_.resize(kept, kept);
     T_.setFromTriplets(t.begin(), t.end());
-    if (kept > 0) t_.analyzePattern(T_);
+    // A tridiagonal T (a reduced link's x1 chain alone) is eliminated in its own order, two sweeps
+    // a solve; any other by a sparse LDLᵀ in AMD order (whose permutations and index lists made the
+    // chain's 60 solves a step 4 % of a reduced run's CPU time).
+    tridiagonal_ = kept > 0;
+    for (int c = 0; c < kept && tridiagonal_; ++c) {
+      const int* row = T_.innerIndexPtr() + T_.outerIndexPtr()[c];
+      const long len = T_.outerIndexPtr()[c + 1] - T_.outerIndexPtr()[c];
+      tridiagonal_ = len >= 1 && row[0] == c && (len == 1 || (len == 2 && row[1] == c + 1));
+    }
+    if (kept > 0 && !tridiagonal_) t_.analyzePattern(T_);
     nnz_ = S.nonZeros();
     size_ = n;
     kept_ = kept;
@@ -413,13 +434,34 @@ bool ReducedFactor::factorize(const SparseMat& S, int kept, bool definite, int t
     for (SparseMat::InnerIterator it(S, kept + c); it; ++it)
       if (it.row() >= kept) schur_(it.row() - kept, c) = it.value();
   if (kept > 0) {
-    t_.factorize(T_);
-    if (t_.info() != Eigen::Success) return false;
-    if (definite && !(t_.vectorD().array() > 0.0).all()) return false;
-    // Yᵀ = (T⁻¹ B)ᵀ a border column at a time, then the Schur complement's upper triangle by rows.
+    if (tridiagonal_) {
+      td_.resize(kept);
+      tl_.resize(kept);
+      const int* outer = T_.outerIndexPtr();
+      const double* tv = T_.valuePtr();
+      auto sub = [&](int c) { return outer[c + 1] - outer[c] == 2 ? tv[outer[c] + 1] : 0.0; };  // T(c + 1, c)
+      td_[0] = tv[outer[0]];
+      tl_[0] = 0.0;
+      for (int i = 1; i < kept; ++i) {
+        tl_[i] = sub(i - 1) / td_[i - 1];
+        td_[i] = tv[outer[i]] - tl_[i] * sub(i - 1);
+      }
+      if (!td_.allFinite() || (definite ? !(td_.array() > 0.0).all() : !(td_.array() != 0.0).all())) return false;
+    } else {
+      t_.factorize(T_);
+      if (t_.info() != Eigen::Success) return false;
+      if (definite && !(t_.vectorD().array() > 0.0).all()) return false;
+    }
+    // Yᵀ = (T⁻¹ B)ᵀ a border column at a time (kSweeps together if T is tridiagonal), then the Schur
+    // complement's upper triangle by rows.
     Yt_.resize(nb, kept);
     for_team_items(nb, team, [&](long b, long e) {
       VecX y;
+      if (tridiagonal_) {
+        Yt_.middleRows(b, e - b) = Bt_.middleRows(b, e - b);
+        for (long i = b; i < e; i += kSweeps) t_solve(Yt_.row(i).data(), Yt_.cols(), static_cast<int>(std::min<long>(kSweeps, e - i)));
+        return;
+      }
       for (long i = b; i < e; ++i) {
         y = t_.solve(Bt_.row(i).transpose());
         Yt_.row(i) = y.transpose();
@@ -442,6 +484,18 @@ bool ReducedFactor::factorize(const SparseMat& S, int kept, bool definite, int t
   return true;
 }
 
+// L D Lᵀ x = b in place for `count` vectors `stride` apart, L unit lower bidiagonal; the vectors'
+// sweeps interleaved (each sweep is a chain of dependent operations: several hide its latency).
+void ReducedFactor::t_solve(double* x, long stride, int count) const {
+  const long n = td_.size();
+  for (long i = 1; i < n; ++i)
+    for (int c = 0; c < count; ++c) x[c * stride + i] -= tl_[i] * x[c * stride + i - 1];
+  for (int c = 0; c < count; ++c)
+    for (long i = 0; i < n; ++i) x[c * stride + i] /= td_[i];
+  for (long i = n - 2; i >= 0; --i)
+    for (int c = 0; c < count; ++c) x[c * stride + i] -= tl_[i + 1] * x[c * stride + i + 1];
+}
+
 void ReducedFactor::solve(VecX& b, int team) const {
   const int kept = kept_, nb = size_ - kept_;
   if (kept == 0) {
@@ -451,7 +505,8 @@ void ReducedFactor::solve(VecX& b, int team) const {
   // (into b itself: 12–13 solves a step, no vector allocated)
   auto x1 = b.head(kept);
   auto x2 = b.tail(nb);
-  x1 = t_.solve(x1);  // T⁻¹ b1 (a sparse LDLᵀ solves in place)
+  if (tridiagonal_) t_solve(x1.data(), 0, 1);  // T⁻¹ b1
+  else x1 = t_.solve(x1);                  // (a sparse LDLᵀ solves in place)
   for_team_items(nb, team, [&](long s, long e) {  // b2 − Bᵀ T⁻¹ b1
     for (long i = s; i < e; ++i) x2[i] -= Bt_.row(i).dot(x1);
   });

@@ -134,7 +134,7 @@ class Projection {
 /// Factor of a reduced (sparse, symmetric) matrix S = [T B; Bᵀ D] split after its `kept` leading
 /// unknowns: T over the rfe coordinates kept (sparse: the x1 chain of a reduced link, the links kept
 /// whole), B and D dense over the modal coordinates and joints that border it. T by a sparse LDLᵀ
-/// (its ordering analysed once per pattern), then the Schur complement D − Bᵀ T⁻¹ B by a dense
+/// (its ordering analysed once per pattern; a tridiagonal T, x1's chain alone, in its own order), then the Schur complement D − Bᵀ T⁻¹ B by a dense
 /// LDLᵀ; a solve is one sparse solve with T and two products with the border on the team (a sparse
 /// LDLᵀ of the whole S filled T's rows with the border and solved it serially: 13 solves a step,
 /// the second thread waiting; docs/performance.md, "Reduced links"). Each product's entries are
@@ -153,6 +153,9 @@ class ReducedFactor {
   RowMat Bt_, Yt_;    // Bᵀ and (T⁻¹ B)ᵀ, border × kept
   MatX schur_;        // D − Bᵀ T⁻¹ B
   Eigen::LDLT<MatX> s_;
+  bool tridiagonal_ = false;  // T tridiagonal: factorised below instead of by t_
+  VecX td_, tl_;              // its D, and L's subdiagonal (tl_[i] = L(i, i − 1))
+  void t_solve(double* x, long stride, int count) const;
   long nnz_ = -1;
   int size_ = -1, kept_ = -1;
 };

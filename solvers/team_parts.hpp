@@ -40,4 +40,17 @@ void for_team_items(long n, int team, F&& f) {
   for_parts(n, team, [n](int t, int T) { return t >= T ? n : n * t / T; }, f);
 }
 
+/// f(t, T) on each thread t of a team of T (T = 1 on the caller's alone if team ≤ 1): several loops'
+/// parts (team_part) in one OpenMP region, where one region each cost a fork and a join. f must not
+/// throw.
+template <class F>
+void for_team_threads(int team, F&& f) {
+  if (team <= 1) {
+    f(0, 1);
+    return;
+  }
+#pragma omp parallel num_threads(team)
+  f(omp_get_thread_num(), omp_get_num_threads());
+}
+
 }  // namespace rfem

@@ -350,16 +350,18 @@ TEST(Dynamics, AReducedLinksSetupKeepsToTheCallersThreads) {
 }
 
 namespace {
-// A reduced Newton matrix's shape: a kept block T, tridiagonal (a reduced link's x1 chain), bordered
-// by nb dense columns (its modal coordinates and the joints); symmetric, with eigenvalues shifted by
-// `shift` from a positive definite start.
-SparseMat bordered_matrix(int kept, int nb, double shift, MatX& dense) {
+// A reduced Newton matrix's shape: a kept block T, tridiagonal (a reduced link's x1 chain; with
+// `wide`, pentadiagonal: links kept whole, by the sparse LDLᵀ), bordered by nb dense columns (its
+// modal coordinates and the joints); symmetric, with eigenvalues shifted by `shift` from a positive
+// definite start.
+SparseMat bordered_matrix(int kept, int nb, double shift, MatX& dense, bool wide = false) {
   const int n = kept + nb;
   std::srand(7);
   MatX A = MatX::Zero(n, n);
   for (int i = 0; i < kept; ++i) {
     A(i, i) = 4.0;
     if (i + 1 < kept) A(i, i + 1) = A(i + 1, i) = -1.0 + 0.1 * (i % 3);
+    if (wide && i + 2 < kept) A(i, i + 2) = A(i + 2, i) = 0.3;
   }
   const MatX B = 0.2 * MatX::Random(kept, nb), D = MatX::Random(nb, nb);
   A.topRightCorner(kept, nb) = B;
@@ -377,31 +379,34 @@ TEST(Dynamics, ReducedFactorSolvesItsBorderedSystemsAsADenseSolve) {
   // The reduced Newton matrix is factorised by its Schur complement (T sparse, the border dense):
   // its solutions equal a dense LDLᵀ's to round-off of a matrix with condition ~10² (1e-12 allows
   // 1e4 ulps), on one and two threads with the same bits; an indefinite matrix is refused as a
-  // Newton matrix and solved as a statics' stiffness.
-  for (const int kept : {0, 60}) {
+  // Newton matrix and solved as a statics' stiffness. T tridiagonal (its own elimination) and not.
+  for (const int kept : {0, 60, -60}) {
     MatX A;
-    const SparseMat S = bordered_matrix(kept, 7, 0.0, A);
-    const VecX b = VecX::LinSpaced(kept + 7, -1.0, 2.0);
+    const bool wide = kept < 0;
+    const SparseMat S = bordered_matrix(std::abs(kept), 7, 0.0, A, wide);
+    const VecX b = VecX::LinSpaced(std::abs(kept) + 7, -1.0, 2.0);
     const VecX exact = A.ldlt().solve(b);
     VecX x1 = b, x2 = b;
     ReducedFactor f1, f2;
-    ASSERT_TRUE(f1.factorize(S, kept, true, 1));
-    ASSERT_TRUE(f2.factorize(S, kept, true, 2));
+    ASSERT_TRUE(f1.factorize(S, std::abs(kept), true, 1));
+    ASSERT_TRUE(f2.factorize(S, std::abs(kept), true, 2));
     f1.solve(x1, 1);
     f2.solve(x2, 2);
     EXPECT_LT((x1 - exact).norm(), 1e-12 * exact.norm()) << "kept " << kept;
     EXPECT_EQ(x1, x2) << "one and two threads differ, kept " << kept;
   }
-  MatX A;
-  const SparseMat S = bordered_matrix(60, 7, 3.5, A);  // T's diagonal 0.5: indefinite overall
-  ASSERT_LT(Eigen::SelfAdjointEigenSolver<MatX>(A).eigenvalues()[0], 0.0);
-  ReducedFactor f;
-  EXPECT_FALSE(f.factorize(S, 60, true)) << "an indefinite Newton matrix was taken";
-  ASSERT_TRUE(f.factorize(S, 60, false));
-  const VecX b = VecX::Ones(67);
-  VecX x = b;
-  f.solve(x);
-  EXPECT_LT((A * x - b).norm(), 1e-10 * b.norm());
+  for (const bool wide : {false, true}) {
+    MatX A;
+    const SparseMat S = bordered_matrix(60, 7, 3.5, A, wide);  // T's diagonal 0.5: indefinite overall
+    ASSERT_LT(Eigen::SelfAdjointEigenSolver<MatX>(A).eigenvalues()[0], 0.0);
+    ReducedFactor f;
+    EXPECT_FALSE(f.factorize(S, 60, true)) << "an indefinite Newton matrix was taken";
+    ASSERT_TRUE(f.factorize(S, 60, false));
+    const VecX b = VecX::Ones(67);
+    VecX x = b;
+    f.solve(x);
+    EXPECT_LT((A * x - b).norm(), 1e-10 * b.norm()) << "wide " << wide;
+  }
 }
 
 TEST(Dynamics, AStagesResidualIsTheResidualOfItsStates) {
