@@ -294,6 +294,16 @@ Projection::Projection(const Reduction& red, const BorderedPattern& pattern) : r
     }
     lat_ptr_[static_cast<size_t>(c) + 1] = static_cast<long>(lat_.size());
   }
+  twin_.assign(static_cast<size_t>(n), 0);  // column c's lateral entries in the same links and rows of Φ as c + 1's
+  for (int c = 0; c + 1 < n; ++c) {
+    const long len = lat_ptr_[c + 1] - lat_ptr_[c];
+    bool same = len > 0 && lat_ptr_[c + 2] - lat_ptr_[c + 1] == len;
+    for (long t = 0; same && t < len; ++t) {
+      const Lateral &a = lat_[static_cast<size_t>(lat_ptr_[c] + t)], &b = lat_[static_cast<size_t>(lat_ptr_[c + 1] + t)];
+      same = a.link == b.link && a.phi_row == b.phi_row;
+    }
+    twin_[static_cast<size_t>(c)] = same;
+  }
   W_.resize(static_cast<size_t>(L));
   for (int l = 0; l < L; ++l) W_[static_cast<size_t>(l)].setZero(w_rows, links[l].phi.cols());  // (the η rows stay 0)
   G_.resize(static_cast<size_t>(L * L));
@@ -303,6 +313,50 @@ namespace {
 constexpr int kWBlock = 8;     // columns of W = S Φ summed in registers
 constexpr int kSweeps = 4;     // border columns of T⁻¹ B swept together
 constexpr int kGramBlock = 8;  // columns of Φ_lᵀ W_l' per product (fixed: each entry's sum is the same for any team)
+}
+
+// W rows i … i + R − 1 from their lateral entries lat_[lat_ptr_[i + r] + skip …] (count of them,
+// one link's; the same rows of Φ for every r: twin_): the rows of Φ summed in S's order, eight
+// columns at a time in registers (adding each row of Φ to W's row in memory waited on the store:
+// 2× slower), each load of Φ serving the R rows.
+template <int R>
+void Projection::w_rows(long i, long skip, long count, const double* v) {
+  const Lateral* x[R];
+  double* w[R];
+  const int l = lat_[static_cast<size_t>(lat_ptr_[i] + skip)].link;
+  for (int r = 0; r < R; ++r) {
+    x[r] = lat_.data() + lat_ptr_[i + r] + skip;
+    w[r] = W_[static_cast<size_t>(l)].row(w_row_[i + r]).data();
+  }
+  const auto& phi_rows = red_->links()[static_cast<size_t>(l)].phi_rows;
+  const long m = phi_rows.cols();
+  const double* phi = phi_rows.data();
+  using Block = Eigen::Array<double, kWBlock, 1>;
+  long c = 0;
+  for (; c + kWBlock <= m; c += kWBlock) {
+    Block acc[R];
+    for (int r = 0; r < R; ++r) acc[r].setZero();
+    for (long t = 0; t < count; ++t) {
+      const Eigen::Map<const Block> f(phi + x[0][t].phi_row * m + c);
+      for (int r = 0; r < R; ++r) acc[r] += v[x[r][t].value] * f;
+    }
+    for (int r = 0; r < R; ++r) Eigen::Map<Block>(w[r] + c) += acc[r];
+  }
+  for (; c + 2 <= m; c += 2) {
+    Eigen::Array2d acc[R];
+    for (int r = 0; r < R; ++r) acc[r].setZero();
+    for (long t = 0; t < count; ++t) {
+      const Eigen::Map<const Eigen::Array2d> f(phi + x[0][t].phi_row * m + c);
+      for (int r = 0; r < R; ++r) acc[r] += v[x[r][t].value] * f;
+    }
+    for (int r = 0; r < R; ++r) Eigen::Map<Eigen::Array2d>(w[r] + c) += acc[r];
+  }
+  for (; c < m; ++c)
+    for (int r = 0; r < R; ++r) {
+      double acc = 0.0;
+      for (long t = 0; t < count; ++t) acc += v[x[r][t].value] * phi[x[0][t].phi_row * m + c];
+      w[r][c] += acc;
+    }
 }
 
 const SparseMat& Projection::reduce(const std::vector<double>& values, int team) {
@@ -319,40 +373,18 @@ const SparseMat& Projection::reduce(const std::vector<double>& values, int team)
   // in Φ's order, so Φ_lᵀ W_l' reads W in place.
   for_team_parts(n, team, [&](long b, long e) {
     for (long i = b; i < e; ++i) {
-      for (int l = 0; l < L; ++l) W_[static_cast<size_t>(l)].row(w_row_[i]).setZero();
+      const int R = twin_[static_cast<size_t>(i)] && i + 1 < e ? 2 : 1;  // (the same sums either way)
+      for (int r = 0; r < R; ++r)
+        for (int l = 0; l < L; ++l) W_[static_cast<size_t>(l)].row(w_row_[i + r]).setZero();
       for (long p = lat_ptr_[i], p1 = lat_ptr_[i + 1]; p < p1;) {
         const int l = lat_[static_cast<size_t>(p)].link;
         long q = p;  // [p, q): link l's entries
         while (q < p1 && lat_[static_cast<size_t>(q)].link == l) ++q;
-        const long m = links[l].phi_rows.cols();
-        const double* phi = links[l].phi_rows.data();
-        double* w = W_[static_cast<size_t>(l)].row(w_row_[i]).data();
-        // Eight columns at a time summed in registers (adding each row of Φ to W's row in memory
-        // waited on the store before: 2× slower).
-        long c = 0;
-        for (; c + kWBlock <= m; c += kWBlock) {
-          Eigen::Array<double, kWBlock, 1> acc = Eigen::Array<double, kWBlock, 1>::Zero();
-          for (long t = p; t < q; ++t) {
-            const Lateral& x = lat_[static_cast<size_t>(t)];
-            acc += v[x.value] * Eigen::Map<const Eigen::Array<double, kWBlock, 1>>(phi + x.phi_row * m + c);
-          }
-          Eigen::Map<Eigen::Array<double, kWBlock, 1>>(w + c) += acc;
-        }
-        for (; c + 2 <= m; c += 2) {
-          Eigen::Array2d acc = Eigen::Array2d::Zero();
-          for (long t = p; t < q; ++t) {
-            const Lateral& x = lat_[static_cast<size_t>(t)];
-            acc += v[x.value] * Eigen::Map<const Eigen::Array2d>(phi + x.phi_row * m + c);
-          }
-          Eigen::Map<Eigen::Array2d>(w + c) += acc;
-        }
-        for (; c < m; ++c) {
-          double acc = 0.0;
-          for (long t = p; t < q; ++t) acc += v[lat_[static_cast<size_t>(t)].value] * phi[lat_[static_cast<size_t>(t)].phi_row * m + c];
-          w[c] += acc;
-        }
+        if (R == 2) w_rows<2>(i, p - lat_ptr_[i], q - p, v);
+        else w_rows<1>(i, p - lat_ptr_[i], q - p, v);
         p = q;
       }
+      i += R - 1;
     }
   });
   for (int l = 0; l < L; ++l)  // Φ_lᵀ W_l' in column blocks, W_l' at link l's lateral rows

@@ -125,6 +125,9 @@ class Projection {
   };
   std::vector<long> lat_ptr_;   // column i's lateral entries: lat_[lat_ptr_[i] … lat_ptr_[i + 1])
   std::vector<Lateral> lat_;
+  std::vector<char> twin_;      // column i's lateral entries in the same rows of Φ as column i + 1's
+  template <int R>
+  void w_rows(long i, long skip, long count, const double* v);
   std::vector<RowMat> W_;       // S Φ_l over every full row (row i from S's column i: S is symmetric; rows by w_row_)
   std::vector<int> w_row_;      // per full coordinate: its row of W_l (kept ones first, then each link's lateral rows)
   std::vector<int> lateral_first_;  // per link: W's row of its first lateral coordinate
