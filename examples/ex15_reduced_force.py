@@ -23,7 +23,7 @@ Measured on the project's two-core machine (one thread), at the default toleranc
 1.4 s (m = 8 with the derivatives) — at n = 60 a reduced step costs about what a full one does (the
 full residual is still evaluated, and the projection is added), and the coupled modes of the kept
 shapes reach tens of Hz. bench/reduction_bench.py measures n = 1 000, where at atol 1e-8 the force
-run with the derivatives takes 1.35–1.44× the full kinematic run (README, "Reduced links").
+run with the derivatives takes 1.32–1.44× the full kinematic run (README, "Reduced links").
 
     PYTHONPATH=build/python /usr/bin/python3 examples/ex15_reduced_force.py        (~8 s)
 """
