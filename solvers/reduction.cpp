@@ -62,21 +62,6 @@ SparseMat Reduction::projector(int k) const {
   return P;
 }
 
-void Reduction::lift(const double* x, double* xf, int k, bool positions, int team) const {
-  for_team_parts(static_cast<long>(kept_.size()), team, [&](long b, long e) {
-    for (long i = b; i < e; ++i) xf[kept_[i]] = x[i];
-  });
-  for (const Link& r : links_) {
-    const Eigen::Map<const VecX> eta(x + r.first, r.phi.cols());
-    for_team_parts(static_cast<long>(r.rfe.size()), team, [&](long b, long end) {
-      for (long e = b; e < end; ++e)
-        for (int a = 0; a < kModalAxes; ++a)
-          xf[r.rfe[e] + 1 + a] = r.phi_rows.row(kModalAxes * e + a).dot(eta) + (positions ? r.q0[6 * e + 1 + a] : 0.0);
-    });
-  }
-  for (int j = 0; j < k; ++j) xf[full_rfe_ + j] = x[rfe_ + j];
-}
-
 namespace {
 // Φ_l's rows of rfes [b, e) times `cols` (1–3) vectors η (reduced, at the link's first column) into
 // out (5(e − b) rows per vector, one after the other): each entry a dot product of a row of Φ_l
@@ -89,7 +74,8 @@ void phi_times(const Reduction::Link& r, long b, long e, const double* const* x,
     for (long i = 0; i < rows; ++i) out[c * rows + i] = r.phi_rows.row(kModalAxes * b + i).dot(eta.transpose());
   }
 }
-// A thread's scratch for phi_times, kept between calls (grown once: no allocation per residual).
+// A thread's scratch for phi_times and the projection, kept between calls (grown once: no
+// allocation per residual).
 double* scratch(size_t n) {
   thread_local std::vector<double> s;
   if (s.size() < n) s.resize(n);
@@ -97,28 +83,48 @@ double* scratch(size_t n) {
 }
 }  // namespace
 
-void Reduction::lift_state(const double* q, const double* v, const double* a, double* qf, double* vf, double* af, int k,
-                           int team) const {
-  const int cols = a ? 3 : 2;
-  const double* x[3] = {q, v, a};
-  double* xf[3] = {qf, vf, af};
-  for_team_threads(team, [&](int t, int T) {  // (one region: kept coordinates, then each link's rows)
+// The lifts' loop, in one parallel region: kept(i, full index) for each kept coordinate i; for each
+// reduced link's rows in the thread's part, Φ times the `cols` vectors x, then lateral(link, rfe e,
+// axis, full index, d) with vector c's product at d[c · stride].
+template <class Kept, class Lateral>
+void Reduction::for_lifted(const double* const* x, int cols, int team, Kept&& kept, Lateral&& lateral) const {
+  for_team_threads(team, [&](int t, int T) {
     const long nk = static_cast<long>(kept_.size());
-    for (long i = team_part(nk, t, T); i < team_part(nk, t + 1, T); ++i)
-      for (int c = 0; c < cols; ++c) xf[c][kept_[i]] = x[c][i];
+    for (long i = team_part(nk, t, T); i < team_part(nk, t + 1, T); ++i) kept(i, kept_[i]);
     for (const Link& r : links_) {
       const long n = static_cast<long>(r.rfe.size()), b = team_part(n, t, T), end = team_part(n, t + 1, T);
       const long rows = kModalAxes * (end - b);
       double* part = scratch(static_cast<size_t>(cols * rows));
       phi_times(r, b, end, x, cols, part);
       for (long e = b; e < end; ++e)
-        for (int ax = 0; ax < kModalAxes; ++ax) {
-          const long at = r.rfe[e] + 1 + ax, row = kModalAxes * (e - b) + ax;
-          xf[0][at] = part[row] + r.q0[6 * e + 1 + ax];
-          for (int c = 1; c < cols; ++c) xf[c][at] = part[c * rows + row];
-        }
+        for (int ax = 0; ax < kModalAxes; ++ax)
+          lateral(r, e, ax, r.rfe[e] + 1 + ax, part + kModalAxes * (e - b) + ax, rows);
     }
   });
+}
+
+void Reduction::lift(const double* x, double* xf, int k, bool positions, int team) const {
+  for_lifted(&x, 1, team, [&](long i, long at) { xf[at] = x[i]; },
+             [&](const Link& r, long e, int ax, long at, const double* d, long) {
+               xf[at] = d[0] + (positions ? r.q0[6 * e + 1 + ax] : 0.0);
+             });
+  for (int j = 0; j < k; ++j) xf[full_rfe_ + j] = x[rfe_ + j];
+}
+
+void Reduction::lift_state(const double* q, const double* v, const double* a, double* qf, double* vf, double* af, int k,
+                           int team) const {
+  const int cols = a ? 3 : 2;
+  const double* x[3] = {q, v, a};
+  double* xf[3] = {qf, vf, af};
+  for_lifted(
+      x, cols, team,
+      [&](long i, long at) {
+        for (int c = 0; c < cols; ++c) xf[c][at] = x[c][i];
+      },
+      [&](const Link& r, long e, int ax, long at, const double* d, long stride) {
+        xf[0][at] = d[0] + r.q0[6 * e + 1 + ax];
+        for (int c = 1; c < cols; ++c) xf[c][at] = d[c * stride];
+      });
   for (int j = 0; j < k; ++j)
     for (int c = 0; c < cols; ++c) xf[c][full_rfe_ + j] = x[c][rfe_ + j];
 }
@@ -126,27 +132,18 @@ void Reduction::lift_state(const double* q, const double* v, const double* a, do
 void Reduction::lift_stage(const double* Q, const double* V, const double* A, const double* qk, const double* vk, double hg,
                            double* qf, double* vf, double* af, int k, int team) const {
   const double hg2 = hg * hg;
-  for_team_threads(team, [&](int t, int T) {  // (one region: kept coordinates, then each link's rows)
-    const long nk = static_cast<long>(kept_.size());
-    for (long i = team_part(nk, t, T); i < team_part(nk, t + 1, T); ++i) {
-      qf[kept_[i]] = Q[i];
-      vf[kept_[i]] = V[i];
-      af[kept_[i]] = A[i];
-    }
-    for (const Link& r : links_) {
-      const long n = static_cast<long>(r.rfe.size()), b = team_part(n, t, T), end = team_part(n, t + 1, T);
-      double* part = scratch(static_cast<size_t>(kModalAxes * (end - b)));
-      phi_times(r, b, end, &A, 1, part);
-      for (long e = b; e < end; ++e)
-        for (int ax = 0; ax < kModalAxes; ++ax) {
-          const long at = r.rfe[e] + 1 + ax;
-          const double d = part[static_cast<size_t>(kModalAxes * (e - b) + ax)];
-          af[at] = d;
-          vf[at] = vk[at] + hg * d;
-          qf[at] = qk[at] + hg2 * d;
-        }
-    }
-  });
+  for_lifted(
+      &A, 1, team,
+      [&](long i, long at) {
+        qf[at] = Q[i];
+        vf[at] = V[i];
+        af[at] = A[i];
+      },
+      [&](const Link&, long, int, long at, const double* d, long) {
+        af[at] = d[0];
+        vf[at] = vk[at] + hg * d[0];
+        qf[at] = qk[at] + hg2 * d[0];
+      });
   for (int j = 0; j < k; ++j) {
     qf[full_rfe_ + j] = Q[rfe_ + j];
     vf[full_rfe_ + j] = V[rfe_ + j];
@@ -488,12 +485,12 @@ bool ReducedFactor::factorize(const SparseMat& S, int kept, bool definite, int t
     // complement's upper triangle by rows.
     Yt_.resize(nb, kept);
     for_team_items(nb, team, [&](long b, long e) {
-      VecX y;
       if (tridiagonal_) {
         Yt_.middleRows(b, e - b) = Bt_.middleRows(b, e - b);
         for (long i = b; i < e; i += kSweeps) t_solve(Yt_.row(i).data(), Yt_.cols(), static_cast<int>(std::min<long>(kSweeps, e - i)));
         return;
       }
+      VecX y;
       for (long i = b; i < e; ++i) {
         y = t_.solve(Bt_.row(i).transpose());
         Yt_.row(i) = y.transpose();

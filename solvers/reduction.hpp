@@ -87,6 +87,8 @@ class Reduction {
   const std::vector<int>& quasi_static() const { return quasi_static_; }
 
  private:
+  template <class Kept, class Lateral>
+  void for_lifted(const double* const* x, int cols, int team, Kept&& kept, Lateral&& lateral) const;
   int full_rfe_ = 0, rfe_ = 0;
   std::vector<int> kept_;  ///< full index of each kept rfe coordinate (they come first)
   std::vector<Link> links_;
