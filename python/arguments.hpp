@@ -67,10 +67,24 @@ inline int threads(py::handle v, const std::string& name = "threads") {
   return t;
 }
 
+/// Whether v is one real number: a Python int or float, or a numpy scalar or 0-d array of an integer
+/// or floating type (float32 too); not a bool, a string or an array of several values.
+inline bool is_real(py::handle v) {
+  if (PyBool_Check(v.ptr())) return false;
+  if (PyFloat_Check(v.ptr())) return true;  // (numpy's float64 too)
+  // numpy's scalars and arrays first: an array has __index__ too (which fails unless it is one integer)
+  if (!py::hasattr(v, "dtype") || !py::hasattr(v, "ndim")) return PyIndex_Check(v.ptr());
+  try {
+    const std::string kind = py::str(v.attr("dtype").attr("kind")).cast<std::string>();
+    return v.attr("ndim").cast<long>() == 0 && (kind == "f" || kind == "i" || kind == "u");
+  } catch (const py::error_already_set&) {
+    return false;
+  }
+}
+
 /// A real number: int or float (numpy's too), not a bool or a string; finite unless allowed.
 inline double real(py::handle v, const std::string& name, const std::string& what = "a finite number") {
-  const bool number = PyFloat_Check(v.ptr()) || (PyIndex_Check(v.ptr()) && !PyBool_Check(v.ptr()));
-  if (!number) type_error(name, "a number", v);
+  if (!is_real(v)) type_error(name, "a number", v);
   double x = NAN;
   try {
     x = py::float_(py::reinterpret_borrow<py::object>(v)).cast<double>();

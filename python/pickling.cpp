@@ -33,6 +33,24 @@ std::vector<Origin>& registry() {
   return r;
 }
 
+// A pickle's tuple taken apart by `f`: an entry of the wrong type (a tampered or foreign pickle) is
+// rfem's ValueError, not pybind11's cast message.
+template <class F>
+auto unpickled(const char* what, F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const py::cast_error&) {
+    throw py::value_error(std::string("not a pickled rfem.") + what + " of this version of rfem (" + version_string +
+                          "): an entry of the wrong type");
+  }
+}
+
+// A count read back from a pickle: a whole number ≥ 0.
+long counted(long x, const char* what, const char* entry) {
+  if (x < 0) throw py::value_error(std::string("not a pickled rfem.") + what + ": " + entry + " = " + std::to_string(x) + " is negative");
+  return x;
+}
+
 void check_version(const py::tuple& t, int version, std::size_t size, const char* what) {
   if (t.size() != size || t[0].cast<int>() != version)
     throw py::value_error(std::string("not a pickled rfem.") + what + " of this version of rfem (" + version_string + ")");
@@ -116,6 +134,9 @@ const Origin* find(const Model* m) {
 
 }  // namespace
 
+std::shared_ptr<Model> model_from_unchecked(const py::tuple& t);
+std::shared_ptr<RunResult> run_from_unchecked(const py::tuple& t);
+
 void remember(const std::shared_ptr<const Model>& model, const Case& cs, int n, bool rigid) {
   if (!model) return;
   std::lock_guard<std::mutex> lock(registry_mutex);
@@ -142,8 +163,10 @@ py::tuple case_state(const Case& cs) {
 }
 
 Case case_from(const py::tuple& t) {
-  check_version(t, kCaseVersion, 5, "Case");
-  return parse_case(t[2].cast<std::string>(), t[1].cast<std::string>(), t[3].cast<std::vector<std::string>>(), t[4].cast<std::string>());
+  return unpickled("Case", [&] {
+    check_version(t, kCaseVersion, 5, "Case");
+    return parse_case(t[2].cast<std::string>(), t[1].cast<std::string>(), t[3].cast<std::vector<std::string>>(), t[4].cast<std::string>());
+  });
 }
 
 py::tuple model_state(const Model& model) {
@@ -156,6 +179,10 @@ py::tuple model_state(const Model& model) {
 }
 
 std::shared_ptr<Model> model_from(const py::tuple& t) {
+  return unpickled("Model", [&] { return model_from_unchecked(t); });
+}
+
+std::shared_ptr<Model> model_from_unchecked(const py::tuple& t) {
   check_version(t, kModelVersion, 4, "Model");
   const Case cs = case_from(t[1].cast<py::tuple>());
   const int n = t[2].cast<int>();
@@ -183,6 +210,31 @@ py::tuple run_state(const RunResult& r) {
 }
 
 std::shared_ptr<RunResult> run_from(const py::tuple& t) {
+  auto r = unpickled("Run", [&] { return run_from_unchecked(t); });
+  // Its parts agree: counts ≥ 0, every table as long as its rows say.
+  const char* what = "Run";
+  counted(r->samples, what, "outputs");
+  for (long c : {r->stats.steps, r->stats.residual_evals, r->stats.factorizations, r->stats.newton_iters, r->stats.newton_fails,
+                 r->stats.error_test_fails})
+    counted(c, what, "a statistic");
+  if (counted(r->sensors.rows, what, "sensor rows") * counted(r->sensors.cols, what, "sensor columns") !=
+          static_cast<long>(r->sensors.data.size()) ||
+      (r->sensors.rows > 0 && r->sensor_columns.size() != static_cast<size_t>(r->sensors.cols)))
+    throw py::value_error("not a pickled rfem.Run: its sensor table does not have the size it says");
+  if (const RunSeries* ser = r->series.get()) {
+    counted(ser->rows, what, "rows");
+    counted(ser->flexible_rows, what, "flexible rows");
+    bool fits = ser->data.size() == ser->layout.series.size() && ser->flexible.size() == ser->layout.flexible.size();
+    for (size_t i = 0; fits && i < ser->data.size(); ++i)
+      fits = static_cast<long>(ser->data[i].size()) == ser->rows * ser->layout.series[i].width();
+    for (size_t i = 0; fits && i < ser->flexible.size(); ++i)
+      fits = static_cast<long>(ser->flexible[i].size()) == ser->flexible_rows * ser->layout.flexible[i].width();
+    if (!fits) throw py::value_error("not a pickled rfem.Run: its series do not have the rows it says");
+  }
+  return r;
+}
+
+std::shared_ptr<RunResult> run_from_unchecked(const py::tuple& t) {
   check_version(t, kRunVersion, 16, "Run");
   auto r = std::make_shared<RunResult>();
   r->name = t[1].cast<std::string>();
@@ -221,11 +273,13 @@ py::tuple sweep_state(const Sweep& s) {
 }
 
 Sweep sweep_from(const py::tuple& t) {
-  check_version(t, kSweepVersion, 4, "Sweep");
-  Sweep s = read_sweep(t[1].cast<std::string>(), t[2].cast<std::string>());
-  if (s.text != t[3].cast<std::string>())
-    throw py::value_error(s.path + ": the sweep file changed since this Sweep was pickled; load it again");
-  return s;
+  return unpickled("Sweep", [&] {
+    check_version(t, kSweepVersion, 4, "Sweep");
+    Sweep s = read_sweep(t[1].cast<std::string>(), t[2].cast<std::string>());
+    if (s.text != t[3].cast<std::string>())
+      throw py::value_error(s.path + ": the sweep file changed since this Sweep was pickled; load it again");
+    return s;
+  });
 }
 
 }  // namespace rfem::pyorigin

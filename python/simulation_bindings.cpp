@@ -6,6 +6,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <atomic>
 #include <csignal>
 #include <memory>
 
@@ -78,6 +79,7 @@ SimulationOptions options(py::handle n, py::handle threads, py::handle output, p
   o.output = args::path(output, "output", true);
   o.keep_series = args::flag(keep_series, "keep_series");
   o.made_by = made_by;
+  o.driven_by = made_by;  // (a script's run: its inputs are the script's)
   if (state) o.state = std::make_shared<const SimulationState>(std::move(*state));
   o.stop = poll->stop;
   o.heartbeat = [poll](double, long) { poll->check(); };
@@ -91,9 +93,17 @@ void control_value(ControlOutput& u, const std::string& name, const std::string&
     throw std::invalid_argument(msg);
   };
   auto number = [&](const py::handle& x) {
-    if (!py::isinstance<py::float_>(x) && !py::isinstance<py::int_>(x) && !py::hasattr(x, "__float__"))
-      bad(PyExc_TypeError, "joint '" + name + "': expected a number, got " + std::string(py::str(py::type::of(x).attr("__name__"))));
-    return x.cast<double>();
+    if (!args::is_real(x)) {
+      std::string got = args::type_name(x);
+      if (py::hasattr(x, "shape")) got += " of shape " + py::str(x.attr("shape")).cast<std::string>();
+      bad(PyExc_TypeError, "joint '" + name + "': expected a number, got " + got);
+    }
+    double y = NAN;
+    try {
+      y = py::float_(py::reinterpret_borrow<py::object>(x)).cast<double>();
+    } catch (const py::error_already_set&) {  // (an int beyond a double's range)
+    }
+    return y;  // (not finite: refused by the loop, a ValueError)
   };
   if (kind == "motion") bad(PyExc_ValueError, "joint '" + name + "' follows a prescribed motion: it takes no torque or reference");
   if (kind == "torque") {
@@ -125,22 +135,48 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("unknowns_v", [](const SimulationState& s) { return array(s.integrator.v); })
       .def("pack", [](const SimulationState& s) { const auto x = s.pack(); return py::array_t<double>(x.size(), x.data()); },
            "the state as one float64 array (with .model, what unpack takes)")
-      .def_static("unpack", &SimulationState::unpack, py::arg("model"), py::arg("packed"))
+      .def_static("unpack", [](const std::string& model, const py::array_t<double, py::array::c_style | py::array::forcecast>& x) {
+        if (x.ndim() != 1) throw py::value_error("packed: a 1-D array of numbers (SimulationState.pack()), not " +
+                                                 std::to_string(x.ndim()) + "-D");
+        return SimulationState::unpack(model, std::vector<double>(x.data(), x.data() + x.size()));
+      }, py::arg("model"), py::arg("packed"))
       .def("save", [](const SimulationState& s, py::handle path) { save_state(s, args::path(path, "path")); }, py::arg("path"),
            "into an HDF5 file of its own (state/packed, state/model)")
       .def_static("load", [](py::handle path) { return load_state(args::path(path, "path")); }, py::arg("path"))
       .def(py::pickle([](const SimulationState& s) { return py::make_tuple(s.model, s.pack()); },
                       [](const py::tuple& t) {
-                        if (t.size() != 2) throw std::invalid_argument("not a pickled SimulationState");
-                        return SimulationState::unpack(t[0].cast<std::string>(), t[1].cast<std::vector<double>>());
+                        if (t.size() != 2 || !PyUnicode_Check(t[0].ptr()))
+                          throw py::value_error("not a pickled rfem.SimulationState");
+                        std::vector<double> x;
+                        try {
+                          x = t[1].cast<std::vector<double>>();
+                        } catch (const py::cast_error&) {
+                          throw py::value_error("not a pickled rfem.SimulationState: its values are not numbers");
+                        }
+                        return SimulationState::unpack(t[0].cast<std::string>(), x);
                       }))
       .def("__repr__", [](const SimulationState& s) {
         return "<rfem.SimulationState t = " + std::to_string(s.time()) + " s, " + std::to_string(s.integrator.q.size()) + " unknowns>";
       });
 
+  // A Simulation is used by one thread at a time: a second thread that enters while the first is in
+  // a call (advance releases the GIL) gets a RuntimeError instead of a data race.
   struct PySimulation {
     std::shared_ptr<Poll> poll = std::make_shared<Poll>();
     std::unique_ptr<Simulation> sim;
+    mutable std::atomic<bool> busy{false};
+  };
+  struct Use {
+    const PySimulation& p;
+    Use(const PySimulation& q, const char* what) : p(q) {
+      if (p.busy.exchange(true))
+        throw std::runtime_error(std::string("rfem.Simulation.") + what + ": the simulation is in use by another thread "
+                                 "(one thread at a time: a lock of your own around its calls)");
+    }
+    ~Use() { p.busy.store(false); }
+    Use(const Use&) = delete;
+    Use& operator=(const Use&) = delete;
+    Simulation* operator->() const { return p.sim.get(); }
   };
   py::class_<PySimulation>(m, "_Simulation")
       .def(py::init([](py::handle case_arg, py::handle n, py::handle threads, py::handle output, py::handle keep_series,
@@ -156,46 +192,52 @@ void bind_simulation(py::module_& m) {
            }),
            py::arg("case"), py::arg("n"), py::arg("threads"), py::arg("output"), py::arg("keep_series"), py::arg("state"),
            py::arg("made_by"))
-      .def_property_readonly("time", [](const PySimulation& p) { return p.sim->time(); })
-      .def_property_readonly("t_end", [](const PySimulation& p) { return p.sim->t_end(); })
-      .def_property_readonly("q", [](const PySimulation& p) { return array(p.sim->q()); })
-      .def_property_readonly("v", [](const PySimulation& p) { return array(p.sim->v()); })
-      .def_property_readonly("coordinate_names", [](const PySimulation& p) { return p.sim->coordinate_names(); })
-      .def_property_readonly("joint_names", [](const PySimulation& p) { return p.sim->joint_names(); })
-      .def_property_readonly("joint_inputs", [](const PySimulation& p) { return p.sim->joint_inputs(); })
-      .def_property_readonly("status", [](const PySimulation& p) { return p.sim->status().to_string(); })
-      .def_property_readonly("finished", [](const PySimulation& p) { return p.sim->finished(); })
-      .def_property_readonly("output", [](const PySimulation& p) { return p.sim->output(); })
+      .def_property_readonly("time", [](const PySimulation& p) { return Use(p, "time")->time(); })
+      .def_property_readonly("t_end", [](const PySimulation& p) { return Use(p, "t_end")->t_end(); })
+      .def_property_readonly("q", [](const PySimulation& p) { return array(Use(p, "q")->q()); })
+      .def_property_readonly("v", [](const PySimulation& p) { return array(Use(p, "v")->v()); })
+      .def_property_readonly("coordinate_names", [](const PySimulation& p) { return Use(p, "coordinate_names")->coordinate_names(); })
+      .def_property_readonly("joint_names", [](const PySimulation& p) { return Use(p, "joint_names")->joint_names(); })
+      .def_property_readonly("joint_inputs", [](const PySimulation& p) { return Use(p, "joint_inputs")->joint_inputs(); })
+      .def_property_readonly("status", [](const PySimulation& p) { return Use(p, "status")->status().to_string(); })
+      .def_property_readonly("finished", [](const PySimulation& p) { return Use(p, "finished")->finished(); })
+      .def_property_readonly("output", [](const PySimulation& p) { return Use(p, "output")->output(); })
       .def("set_torque", [](PySimulation& p, py::handle j, py::handle tau) {
-        p.sim->set_torque(args::text(j, "joint"), args::real(tau, "tau", "a finite torque [N m] or force [N]"));
+        Use(p, "set_torque")->set_torque(args::text(j, "joint"), args::real(tau, "tau", "a finite torque [N m] or force [N]"));
       })
       .def("set_reference", [](PySimulation& p, py::handle j, py::handle q, py::handle v, py::handle ff) {
-        p.sim->set_reference(args::text(j, "joint"), args::real(q, "q"), args::real(v, "qd"), args::real(ff, "tau_ff"));
+        Use(p, "set_reference")->set_reference(args::text(j, "joint"), args::real(q, "q"), args::real(v, "qd"), args::real(ff, "tau_ff"));
       })
-      .def("release", [](PySimulation& p, py::handle j) { p.sim->release(args::text(j, "joint")); })
+      .def("release", [](PySimulation& p, py::handle j) { Use(p, "release")->release(args::text(j, "joint")); })
       .def("advance", [](PySimulation& p, py::handle time) {
         const double t = args::real(time, "t", "a finite time [s]");
         RunStatus s;
         {
+          const Use use(p, "advance");
           py::gil_scoped_release release;
-          s = p.sim->advance(t);
+          s = use->advance(t);
         }
         py::object error = p.poll->error;
         p.poll->error = py::none();
         return py::make_tuple(s.to_string(), error);
       })
-      .def("snapshot", [](PySimulation& p) { return snapshot_dict(p.sim->snapshot(), p.sim->model()); })
-      .def("state", [](const PySimulation& p) { return p.sim->state(); })
+      .def("snapshot", [](PySimulation& p) {
+        const Use use(p, "snapshot");
+        return snapshot_dict(use->snapshot(), use->model());
+      })
+      .def("state", [](const PySimulation& p) { return Use(p, "state")->state(); })
       .def("linearize", [](PySimulation& p, py::handle equilibrium, py::handle dense) {
         const bool eq = args::flag(equilibrium, "equilibrium"), d = args::flag(dense, "dense");
+        const Use use(p, "linearize");
         py::gil_scoped_release release;
-        return std::make_shared<LinearModel>(p.sim->linearize(eq, d));
+        return std::make_shared<LinearModel>(use->linearize(eq, d));
       })
       .def("finish", [](PySimulation& p) {
         std::shared_ptr<RunResult> r;
         {
+          const Use use(p, "finish");
           py::gil_scoped_release release;
-          r = std::make_shared<RunResult>(p.sim->finish());
+          r = std::make_shared<RunResult>(use->finish());
         }
         return r;
       });

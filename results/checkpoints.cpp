@@ -234,6 +234,11 @@ std::unique_ptr<RunWriter> ResultsWriter::resume_run(const std::string& name, st
   };
   for (const SeriesInfo& s : w.layout.series) w.series.push_back(reopen(s, from.rows));
   for (const SeriesInfo& s : w.layout.flexible) w.flexible.push_back(reopen(s, from.flexible_rows));
+  if (w.sensors_info) {  // (a file of an rfem that wrote the sensors only at a run's end has none: refused)
+    if (H5Lexists(w.group, "sensors", H5P_DEFAULT) <= 0)
+      throw ResultsError(w.what("no sensors table to resume in") + " (written by an older rfem): run the case again");
+    w.measured.push_back(reopen(*w.sensors_info, from.rows));
+  }
   w.rows = from.rows;
   w.flex_rows = from.flexible_rows;
   w.status = h5::dataset(H5Dopen2(w.group, "status_now", H5P_DEFAULT), w.what("reopening the status of"));

@@ -83,6 +83,7 @@ ResultsWriter::ResultsWriter(const std::string& path, const FileDescription& d) 
     file_->attribute("/", "case_effective", d.case_effective);
     file_->attribute("/", "overrides", d.overrides);
     file_->attribute("/", "procedure", d.procedure);
+    if (!d.driven_by.empty()) file_->attribute("/", "driven_by", d.driven_by);
     if (d.n >= 0) file_->attribute("/", "n", d.n);
     if (d.n_option >= 0) file_->attribute("/", "n_option", d.n_option);
     file_->attribute("/", "threads", d.threads);
@@ -132,6 +133,11 @@ void ResultsWriter::close() {
   file_->end_swmr();
   file_->flush();
   file_->id.close(file_->what("closing"));
+  // Closed, the file is free for other writers at once (not when the last owner of the writer goes).
+  if (file_->lock_fd >= 0) {
+    ::close(file_->lock_fd);
+    file_->lock_fd = -1;
+  }
 }
 
 namespace {
@@ -279,6 +285,7 @@ std::unique_ptr<RunWriter> ResultsWriter::begin_run(const std::string& name, std
   w.group = h5::group(H5Gcreate2(f.id, name.c_str(), lcpl, H5P_DEFAULT, H5P_DEFAULT), f.what("cannot create group " + name));
   for (const SeriesInfo& s : w.layout.series) w.series.push_back(w.add_series(s));
   for (const SeriesInfo& s : w.layout.flexible) w.flexible.push_back(w.add_series(s));
+  if (w.sensors_info) w.measured.push_back(w.add_series(*w.sensors_info));
   for (const auto& [info, values] : w.layout.constants) {
     const std::string what = w.what("creating " + info.name + " in");
     const hsize_t dims[2] = {values.size() / info.width(), static_cast<hsize_t>(info.width())};
@@ -329,7 +336,8 @@ void RunWriter::append(const OutputSample& s) {
   const bool flexible = !w.flexible.empty() && w.rows % w.layout.flexible_every == 0;
   // The chunks these rows start, and those started since the last flush (still in HDF5's cache,
   // written to the file at the next flush), must fit.
-  const long long fresh = Impl::new_chunks(w.series, w.rows) + (flexible ? Impl::new_chunks(w.flexible, w.flex_rows) : 0);
+  const long long fresh = Impl::new_chunks(w.series, w.rows) + Impl::new_chunks(w.measured, w.rows) +
+                          (flexible ? Impl::new_chunks(w.flexible, w.flex_rows) : 0);
   w.file->require(kMargin + w.unflushed + fresh);
   w.unflushed += fresh;
   sample_rows(*w.model, w.layout, s, w.scratch);
@@ -343,6 +351,18 @@ void RunWriter::append(const OutputSample& s) {
   // Flush at most twice a second: output must not dominate a run, yet little is lost on a crash
   // and a watching reader sees the run advance.
   if (now_s() - w.last_flush > 0.5) w.flush();
+}
+
+void RunWriter::append_sensors(const std::vector<double>& row) {
+  const h5::Quiet quiet;
+  Impl& w = *impl_;
+  if (!w.group.valid()) throw std::logic_error("RunWriter::append_sensors after finish");
+  if (w.measured.empty() || static_cast<long>(row.size()) != w.measured[0].cols || w.rows < 1)
+    throw std::invalid_argument("RunWriter::append_sensors: a row of " + std::to_string(row.size()) +
+                                " values where the run's sensors table has " +
+                                std::to_string(w.measured.empty() ? 0 : w.measured[0].cols) + " (after append)");
+  // The row of the output just appended (rows − 1): its chunk was counted with the output's.
+  w.write_row(w.measured[0], w.rows - 1, row.data());
 }
 
 void RunWriter::finish(const RunOutcome& r, double wall_s, const std::vector<std::string>& warnings) {

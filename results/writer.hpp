@@ -32,6 +32,9 @@ struct FileDescription {
   long n = -1;                 ///< rfes of every run in the file (−1: not one n, as in a refinement)
   long n_option = -1;          ///< the n the runs were asked for (0: the case's own; −1: not one run's)
   long threads = 0;            ///< the largest thread team of the runs
+  /// A run stepped by its caller (rfem::Simulation, a controller in the loop): who drove it. Its
+  /// inputs came from outside the case, so `rfem run --resume` refuses it ("": the case's own run).
+  std::string driven_by;
 };
 
 /// What a run group records about the run besides its series.
@@ -40,6 +43,9 @@ struct RunDescription {
   std::vector<std::string> inputs;  ///< per joint: motion, torque or feedback
   int flexible_every = 0;           ///< store the rfe coordinates every k outputs (0: never)
   long threads = 0;
+  /// The case's [[sensors]] (time first): the group's `sensors` table, a row per output
+  /// (RunWriter::append_sensors); none if empty.
+  std::vector<std::string> sensor_columns, sensor_units;
 };
 
 class RunWriter;
@@ -101,6 +107,8 @@ class RunWriter {
   RunWriter(const RunWriter&) = delete;
   RunWriter& operator=(const RunWriter&) = delete;
   void append(const OutputSample& s);
+  /// The sensors' row of the output just appended (time first; RunDescription::sensor_columns).
+  void append_sensors(const std::vector<double>& row);
   /// Records a checkpoint covering every row appended so far (flushed first), in the older slot.
   /// The state comes in pieces (studies/checkpoints.hpp), written one after the other: no copy of it.
   void checkpoint(const std::vector<std::span<const double>>& pieces);

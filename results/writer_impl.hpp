@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <variant>
 
 #include "rfem/results/h5_impl.hpp"
@@ -135,11 +136,13 @@ struct RunWriter::Impl {
     std::string name;
   };
   std::vector<Series> series, flexible;
+  std::vector<Series> measured;  // the sensors' table (none without sensors): a row per output
   h5::Handle group, status;
   long rows = 0, flex_rows = 0;
   double last_flush = 0.0;
   long long unflushed = 0;  // bytes of chunks started since the last flush
   std::vector<std::vector<double>> scratch;
+  std::optional<SeriesInfo> sensors_info;  // the sensors' table, if the case has sensors
   h5::Handle checkpoints;  // 2 slots × (header + state), results/checkpoints.cpp
   long checkpoint_sequence = 0;
 
@@ -152,6 +155,9 @@ struct RunWriter::Impl {
     p->file = file;
     p->name = name;
     p->layout = run_layout(*model, d.flexible_every);
+    if (!d.sensor_columns.empty())
+      p->sensors_info = SeriesInfo{"sensors", d.sensor_columns, d.sensor_units,
+                                   "the case's [[sensors]] at every output, as measured (noise, resolution)"};
     p->model = std::move(model);
     return p;
   }
@@ -211,7 +217,7 @@ struct RunWriter::Impl {
   void flush() {
     if (!group.valid()) return;
     if (file->swmr) {
-      for (auto* v : {&series, &flexible})
+      for (auto* v : {&series, &flexible, &measured})
         for (auto& s : *v) h5::check(H5Dflush(s.dset), what("flushing " + s.name + " of"));
       if (status.valid()) h5::check(H5Dflush(status), what("flushing the status of"));
     }
@@ -222,7 +228,7 @@ struct RunWriter::Impl {
 
   // Closes the datasets and the group (before the file leaves SWMR mode); never throws.
   void close_quietly() {
-    for (auto* v : {&series, &flexible})
+    for (auto* v : {&series, &flexible, &measured})
       for (auto& s : *v) s.dset.reset();
     status.reset();
     checkpoints.reset();

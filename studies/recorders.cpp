@@ -12,6 +12,8 @@ void Hdf5Recorder::begin(const RunInfo& info) {
   d.inputs = info.inputs;
   d.flexible_every = info.flexible_every;
   d.threads = info.threads;
+  d.sensor_columns = info.sensor_columns;
+  d.sensor_units = info.sensor_units;
   run_ = info.resume ? file_.resume_run(info.name, info.model, d, *info.resume) : file_.begin_run(info.name, info.model, d);
 }
 
@@ -19,15 +21,14 @@ void Hdf5Recorder::checkpoint(const PackedState& state) { run_->checkpoint(state
 
 void Hdf5Recorder::sample(const OutputSample& s) { run_->append(s); }
 
+void Hdf5Recorder::measured(const std::vector<double>& row) { run_->append_sensors(row); }
+
 void Hdf5Recorder::end(const RunResult& r) {
   RunOutcome o;
   o.status = r.status;
   o.t_reached = r.t_reached;
   o.stats = r.stats;
-  run_->finish(o, r.wall_s, r.warnings);
-  if (r.sensors.rows > 0)  // (after finish: SWMR allows no new datasets while the run writes)
-    file_.write_table(r.name + "/sensors", r.sensors, r.sensor_columns, r.sensor_units,
-                      "the case's [[sensors]] at every output, as measured (noise, resolution)");
+  run_->finish(o, r.wall_s, r.warnings);  // (the sensors' table was written row by row)
 }
 
 std::vector<std::string> write_views(const Case& cs, const Model& model, const std::string& results, const Warnings& warn) {

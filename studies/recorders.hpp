@@ -15,6 +15,7 @@ class Hdf5Recorder : public RunObserver {
   explicit Hdf5Recorder(ResultsWriter& file) : file_(file) {}
   void begin(const RunInfo& info) override;
   void sample(const OutputSample& s) override;
+  void measured(const std::vector<double>& row) override;
   void end(const RunResult& r) override;
   void checkpoint(const PackedState& state) override;  // piece by piece into the file
   /// Output steps written of the current (or last) run.

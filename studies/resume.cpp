@@ -9,6 +9,7 @@
 #include "rfem/studies/checkpoints.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/recorders.hpp"
+#include "rfem/studies/sensors.hpp"
 
 namespace rfem {
 
@@ -27,6 +28,16 @@ ResumePlan plan_resume(const std::string& path) {
     const std::string procedure = in.attribute("/", "procedure");
     if (procedure != "single" && procedure != "paper")
       throw CaseError(path + ": procedure '" + procedure + "': only the runs of `rfem run` (single, paper) resume");
+    // A stepped run's inputs (a controller's, the caller's held torques) are not in the file: run
+    // again, it would follow the case's own laws instead. (Files before `driven_by`: by their maker.)
+    std::string driver = in.attribute("/", "driven_by");
+    const std::string maker = in.attribute("/", "command_line");
+    if (driver.empty() && (maker.find("run_controlled") != std::string::npos || maker.find("Simulation") != std::string::npos))
+      driver = maker;
+    if (!driver.empty())
+      throw CaseError(path + ": its run was stepped by " + driver + " (a controller or held inputs from outside the case, "
+                      "not in the file): `rfem run --resume` cannot continue it; run it again from Python, or start "
+                      "rfem.Simulation(case, state=…) from a state you saved");
     const double n = in.number("/", "n_option");
     if (!(n >= 0))
       throw CaseError(path + ": records no n_option (written by an older rfem): run the case again instead");
@@ -43,6 +54,9 @@ ResumePlan plan_resume(const std::string& path) {
     } catch (const std::exception& e) {
       throw CaseError(path + ": its case does not read any more: " + e.what());
     }
+    if (!p.cs.sim.state.empty())
+      throw CaseError(path + ": its run started from a saved state (simulation.state = \"" + p.cs.sim.state +
+                      "\"), which keeps no checkpoints: it cannot be resumed; run the case again (it starts from the same state)");
     for (RunName r : runs_of(p.cs.sim.procedure)) {
       const std::string run = to_string(r);
       if (!in.has(run)) break;  // (not begun: it and the later runs run from t = 0)
@@ -92,10 +106,22 @@ void verify_kept(const ResumePlan& plan, const Model& model) {
       verify(run, l.series, -1);
       verify(run, l.flexible, -1);
     }
+    // The sensors' table (a row per output, NaN allowed: a strain gauge on a rigid link) must hold the
+    // checkpoint's rows too: a file whose run wrote it only at its end (an older rfem) is refused.
+    const long sensor_cols = plan.cs.sensors.empty() ? 0 : static_cast<long>(SensorBank(plan.cs, model).columns().size()) + 1;
     for (const auto& [run, c] : plan.resume) {
       const RunLayout l = layout_of(run);
       verify(run, l.series, c.rows);
       verify(run, l.flexible, c.flexible_rows);
+      if (sensor_cols > 0) {
+        const std::string what = plan.path + ": " + run + "/sensors";
+        if (!in.has(run + "/sensors"))
+          throw CaseError(what + ": missing (written by an rfem that stored the sensors at a run's end): not resumed, run the case again");
+        const Table t = in.table(run + "/sensors");
+        if (t.cols != sensor_cols || t.rows < c.rows)
+          throw CaseError(what + ": " + std::to_string(t.rows) + " × " + std::to_string(t.cols) + " does not fit the checkpoint (" +
+                          std::to_string(c.rows) + " rows × " + std::to_string(sensor_cols) + "): not resumed");
+      }
       try {
         RunState::unpack(c.state, -1);
       } catch (const std::invalid_argument& e) {
@@ -130,7 +156,13 @@ std::vector<RunResult> resume_case(const ResumePlan& plan, RunRequest rq) {
   rq.observers.insert(rq.observers.begin(), &recorder);
   std::vector<RunResult> runs = run_case(cs, model, inputs, rq);
   file.close();
-  // Series kept in memory hold only what came after the checkpoint: the whole run is in the file.
+  // Series and sensor rows kept in memory hold only what came after the checkpoint: the whole run is
+  // in the file.
+  {
+    const ResultsReader in(plan.path);
+    for (RunResult& r : runs)
+      if (r.sensors.cols > 0 && in.has(r.name + "/sensors")) r.sensors = in.table(r.name + "/sensors");
+  }
   if (rq.keep_series) {
     const ResultsReader in(plan.path);
     for (RunResult& r : runs) {

@@ -15,6 +15,7 @@ FileRuns run_from_state(const Case& cs, const RunRequest& rq, const std::string&
   o.threads = rq.threads;
   o.output = output;
   o.made_by = made_by;
+  o.driven_by = "";  // (the case's own laws: see plan_resume for why it still does not resume)
   o.keep_series = rq.keep_series;
   o.observers = rq.observers;
   o.warn = rq.warn;

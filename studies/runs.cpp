@@ -47,7 +47,8 @@ std::vector<std::string> RunSeries::names() const {
 }
 
 namespace {
-constexpr const char* kLawsKey = "joint laws";  // (a RunState key, as an observer's)
+constexpr const char* kLawsKey = "joint laws";  // (RunState keys, as an observer's)
+constexpr const char* kSensorsKey = "sensor streams";
 }  // namespace
 
 RunBook::RunBook(std::string name, std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs, const Case& cs,
@@ -58,7 +59,16 @@ RunBook::RunBook(std::string name, std::shared_ptr<const Model> model, const std
   s.name = std::move(name);
   s.model = model_;
   for (const MountedLink& L : model_->links) s.peaks.push_back({L.name});
-  const RunInfo info{s.name, model_, o, input_kinds(inputs), cs.sim.flexible_every, o.parallel.max_threads(), checkpoint};
+  if (!cs.sensors.empty()) {  // (first: the observers learn its columns)
+    sensors_ = std::make_unique<SensorBank>(cs, *model_);
+    s.sensor_columns = sensors_->columns();
+    s.sensor_units = sensors_->units();
+    s.sensors.cols = static_cast<long>(s.sensor_columns.size()) + 1;  // (time first)
+    s.sensor_columns.insert(s.sensor_columns.begin(), "time");
+    s.sensor_units.insert(s.sensor_units.begin(), "s");
+  }
+  const RunInfo info{s.name, model_, o, input_kinds(inputs), cs.sim.flexible_every, o.parallel.max_threads(), checkpoint,
+                     s.sensor_columns, s.sensor_units};
   for (RunObserver* obs : rq.observers) obs->begin(info);
   inputs_ = inputs;
   if (checkpoint) {
@@ -76,14 +86,17 @@ RunBook::RunBook(std::string name, std::shared_ptr<const Model> model, const std
         if (!x) throw std::invalid_argument("run " + s.name + ": its checkpoint holds no state of " + key);
         obs->restore(*x);
       }
-  }
-  if (!cs.sensors.empty()) {
-    sensors_ = std::make_unique<SensorBank>(cs, *model_);
-    s.sensor_columns = sensors_->columns();
-    s.sensor_units = sensors_->units();
-    s.sensors.cols = static_cast<long>(s.sensor_columns.size()) + 1;  // (time first)
-    s.sensor_columns.insert(s.sensor_columns.begin(), "time");
-    s.sensor_units.insert(s.sensor_units.begin(), "s");
+    if (sensors_) {  // the noise goes on where it was (a checkpoint without it is of an older rfem)
+      const std::vector<double>* x = resumed->find(kSensorsKey);
+      if (!x)
+        throw std::invalid_argument("run " + s.name + ": its checkpoint holds no state of the sensors' noise (written by an "
+                                    "older rfem): not resumed, run the case again");
+      try {
+        sensors_->restore(*x);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument("run " + s.name + ": its checkpoint: " + e.what());
+      }
+    }
   }
   if (rq.keep_series) {
     s.series = std::make_shared<RunSeries>();
@@ -137,15 +150,31 @@ void RunBook::sample(const OutputSample& x) {
   validity_->check(x.q, x.t);
   validity_->check_joints(x.q, x.v, x.tau, x.t);
   if (sensors_) {  // (their own random stream: the same readings whatever a controller asks)
-    s.sensors.data.push_back(x.t);
-    sensors_->read(x.q, x.v, x.a, x.tau, s.sensors.data, 1);
+    streams_before_ = sensors_->save();
+    sensor_t_ = x.t;
+    sensor_row_.assign(1, x.t);
+    sensors_->read(x.q, x.v, x.a, x.tau, sensor_row_, 1);
+    s.sensors.data.insert(s.sensors.data.end(), sensor_row_.begin(), sensor_row_.end());
     ++s.sensors.rows;
+    for (RunObserver* obs : rq_.observers) obs->measured(sensor_row_);
   }
   const double bal = x.energy_balance();
   if (std::isnan(balance0_)) balance0_ = bal;
   s.energy_drift = std::max(s.energy_drift, std::abs(bal - balance0_));
   s.energy_scale = std::max({s.energy_scale, x.energy.kinetic, std::abs(x.energy.elastic), std::abs(x.input_work)});
   ++s.samples;
+  // A diverged solution ends the run (failed: "diverged at t = …"), every row up to here kept.
+  if (const std::string why = validity_->diverged(x.q, x.t); !why.empty()) throw std::runtime_error(why);
+}
+
+std::vector<double> RunBook::sensor_streams(double t) const {
+  if (!sensors_) return {};
+  return t == sensor_t_ ? streams_before_ : sensors_->save();
+}
+
+void RunBook::restore_sensor_streams(const std::vector<double>& x) {
+  if (sensors_) sensors_->restore(x);
+  else if (!x.empty()) throw std::invalid_argument("the state holds the noise of sensors that the case does not have");
 }
 
 double RunBook::wall() const {
@@ -163,6 +192,7 @@ void RunBook::checkpoint(const IntegratorState& st) {
   for (RunObserver* obs : rq_.observers)
     if (const std::string key = obs->state_key(); !key.empty()) x.add(key, obs->save());
   if (std::vector<double> laws = pack_law_memory(inputs_); !laws.empty()) x.add(kLawsKey, std::move(laws));
+  if (sensors_) x.add(kSensorsKey, sensors_->save());
   const PackedState packed(st, x.summary, x.observers);
   for (RunObserver* obs : rq_.observers) obs->checkpoint(packed);
 }

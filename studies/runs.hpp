@@ -79,6 +79,9 @@ struct RunInfo {
   long threads = 0;                 ///< the largest team the run may use
   /// The checkpoint the run resumes from (its rows before it kept; null: from t = 0).
   const Checkpoint* resume = nullptr;
+  /// The case's [[sensors]]: the columns of the row measured() gets at every output (time first),
+  /// and their units; empty without sensors.
+  std::vector<std::string> sensor_columns, sensor_units;
 };
 
 /// Sees every run of a study as it goes. A throwing sample() ends that run as failed with the
@@ -90,6 +93,9 @@ class RunObserver {
   virtual ~RunObserver() = default;
   virtual void begin(const RunInfo&) {}
   virtual void sample(const OutputSample&) {}
+  /// The sensors as measured at the output just sampled (time first; RunInfo::sensor_columns):
+  /// called after sample() when the case has [[sensors]].
+  virtual void measured(const std::vector<double>& /*row*/) {}
   virtual void end(const RunResult&) {}
   /// A checkpoint of the run (RunRequest::checkpoint_interval) after the samples so far: `state`
   /// is everything a resumed run needs (studies/checkpoints.hpp); the observer that keeps the
@@ -165,6 +171,12 @@ class RunBook {
   RunResult end(RunOutcome r);
   /// The result so far (status Running).
   const RunResult& result() const { return s_; }
+  /// Where the recorded sensors' random streams are (SensorBank::save) for a state taken at time t:
+  /// before the row at t if one was recorded there (a simulation started from the state records that
+  /// row again, with the same noise), else now. Empty without sensors.
+  std::vector<double> sensor_streams(double t) const;
+  /// Sets them (a simulation started from a state); std::invalid_argument for another case's.
+  void restore_sensor_streams(const std::vector<double>& x);
 
  private:
   double wall() const;
@@ -176,6 +188,8 @@ class RunBook {
   std::unique_ptr<SensorBank> sensors_;  // null without [[sensors]]
   std::vector<JointInput> inputs_;  // (sharing the run's laws: their memory is checkpointed)
   std::vector<std::vector<double>> rows_;
+  std::vector<double> sensor_row_, streams_before_;  // the last sensors' row; the streams before it
+  double sensor_t_ = NAN;                             // its time
   double balance0_ = NAN, wall_before_ = 0.0;
   std::chrono::steady_clock::time_point t0_;
 };

@@ -11,7 +11,10 @@ SensorBank::SensorBank(const Case& cs, const Model& model) : model_(model) {
   for (const SensorSpec& s : cs.sensors) {
     Resolved r;
     r.spec = s;
-    for (int k = 0; k < 2; ++k) r.random[k].seed(static_cast<unsigned long long>(s.seed) * 2 + static_cast<unsigned long long>(k));
+    for (int k = 0; k < 2; ++k) {
+      r.random[k].seed = static_cast<unsigned long long>(s.seed) * 2 + static_cast<unsigned long long>(k);
+      r.random[k].engine.seed(r.random[k].seed);
+    }
     if (!s.joint.empty()) {
       for (int j = 0; j < model.m(); ++j)
         if (model.joints[j].name == s.joint) r.joint = j;
@@ -148,6 +151,33 @@ void SensorBank::read(const VecX& q, const VecX& v, const VecX& a, const VecX& t
       if (r.spec.quantum > 0) out[i] = r.spec.quantum * std::round(out[i] / r.spec.quantum);
     }
   }
+}
+
+std::vector<double> SensorBank::save() const {
+  std::vector<double> x;  // (counts are exact as doubles below 2⁵³)
+  for (const Resolved& r : sensors_)
+    for (const Stream& st : r.random) x.push_back(static_cast<double>(st.drawn));
+  return x;
+}
+
+void SensorBank::restore(const std::vector<double>& x) {
+  if (x.size() != 2 * sensors_.size())
+    throw std::invalid_argument("the sensors' random streams: " + std::to_string(x.size() / 2) + " sensors saved, the case has " +
+                                std::to_string(sensors_.size()));
+  for (double c : x)
+    if (!(c >= 0 && c <= 9007199254740992.0 && c == std::floor(c)))
+      throw std::invalid_argument("the sensors' random streams: a count that is not a whole number ≥ 0");
+  size_t i = 0;
+  for (Resolved& r : sensors_)
+    for (Stream& st : r.random) {
+      const auto want = static_cast<unsigned long long>(x[i++]);
+      if (want < st.drawn) {  // (an engine goes forward only: from its seed again)
+        st.engine.seed(st.seed);
+        st.drawn = 0;
+      }
+      st.engine.discard(want - st.drawn);
+      st.drawn = want;
+    }
 }
 
 }  // namespace rfem

@@ -27,13 +27,30 @@ class SensorBank {
   /// exact, or as measured (noise, then quantisation) from the random streams of `stream`
   /// (0: the controller's snapshots, 1: the recorded outputs), which advance.
   void read(const VecX& q, const VecX& v, const VecX& a, const VecX& tau, std::vector<double>& out, int stream = -1);
+  /// Where the random streams are (per sensor and stream, the numbers drawn so far), and back: a
+  /// resumed run or a simulation started from a state reads the same noise as the run it continues.
+  /// restore throws std::invalid_argument for another bank's state.
+  std::vector<double> save() const;
+  void restore(const std::vector<double>& state);
 
  private:
+  // A random engine that counts its draws: its state is (seed, count).
+  struct Stream {
+    std::mt19937_64 engine;
+    unsigned long long seed = 0, drawn = 0;
+    using result_type = std::mt19937_64::result_type;
+    static constexpr result_type min() { return std::mt19937_64::min(); }
+    static constexpr result_type max() { return std::mt19937_64::max(); }
+    result_type operator()() {
+      ++drawn;
+      return engine();
+    }
+  };
   struct Resolved {
     SensorSpec spec;
     int joint = -1, link = -1, sde = -1;
     double EI = 0.0;  // strain: the bending stiffness of the gauge's section [N m²]
-    std::mt19937_64 random[2];
+    Stream random[2];
   };
   const Model& model_;
   std::vector<Resolved> sensors_;

@@ -4,6 +4,8 @@
 #include <deque>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 #include "rfem/core/check.hpp"
 #include "rfem/core/positions.hpp"
 #include "rfem/results/errors.hpp"
@@ -18,7 +20,7 @@ namespace rfem {
 
 namespace {
 
-constexpr double kStateVersion = 2.0;  // (1: no memory of the laws; still read)
+constexpr double kStateVersion = 3.0;  // (1: no memory of the laws, 2: no sensors' noise; still read)
 // What a joint holds (SimulationState::drives: the mode, then τ, q_ref, q̇_ref, τ_ff).
 constexpr int kHeldNone = 0, kHeldTorque = 1, kHeldReference = 2, kDriveValues = 5;
 
@@ -65,6 +67,8 @@ std::vector<double> SimulationState::pack() const {
   x.insert(x.end(), laws.begin(), laws.end());
   const std::vector<double> i = integrator.pack();
   x.insert(x.end(), i.begin(), i.end());
+  x.push_back(static_cast<double>(sensors.size()));  // (after the integrator: its length is in its head)
+  x.insert(x.end(), sensors.begin(), sensors.end());
   return x;
 }
 
@@ -75,18 +79,37 @@ SimulationState SimulationState::unpack(const std::string& model, const std::vec
     if (i >= x.size() || !(x[i] >= 0) || x[i] != std::floor(x[i]) || x[i] > static_cast<double>(x.size() - i - 1)) throw bad();
     return static_cast<size_t>(x[i]);
   };
-  if (x.size() < 2 || (x[0] != kStateVersion && x[0] != 1.0)) throw bad();
+  if (x.size() < 2 || (x[0] != kStateVersion && x[0] != 2.0 && x[0] != 1.0)) throw bad();
   SimulationState s;
   s.model = model;
   const size_t nd = count(1);
   s.drives.assign(x.begin() + 2, x.begin() + 2 + static_cast<long>(nd));
   size_t i = 2 + nd;
-  if (x[0] == kStateVersion) {
+  const auto block = [&](std::vector<double>& to) {
     const size_t k = count(i++);
-    s.laws.assign(x.begin() + static_cast<long>(i), x.begin() + static_cast<long>(i + k));
+    to.assign(x.begin() + static_cast<long>(i), x.begin() + static_cast<long>(i + k));
     i += k;
+  };
+  if (x[0] >= 2.0) block(s.laws);
+  size_t end = x.size();
+  if (x[0] >= 3.0) {  // the integrator's state (its head, then q, v, a), then the sensors' block
+    const size_t head = IntegratorState{}.pack_head().size();
+    if (i + head > x.size()) throw bad();
+    const double u = x[i + head - 1];
+    if (!(u >= 0 && u == std::floor(u) && u <= static_cast<double>(x.size()))) throw bad();
+    end = i + head + 3 * static_cast<size_t>(u);
+    if (end >= x.size()) throw std::invalid_argument("the state of " + std::to_string(static_cast<long>(u)) + " unknowns is cut short");
+    size_t j = end;
+    std::swap(i, j);
+    block(s.sensors);
+    std::swap(i, j);
+    if (j != x.size()) throw std::invalid_argument("the state has values after its end: not a state of this version of rfem");
   }
-  s.integrator = IntegratorState::unpack(std::vector<double>(x.begin() + static_cast<long>(i), x.end()), -1);
+  for (double d : s.drives)
+    if (!std::isfinite(d)) throw std::invalid_argument("the state's held drive values are not finite");
+  for (double d : s.laws)
+    if (!std::isfinite(d)) throw std::invalid_argument("the state's memory of the joints' laws is not finite");
+  s.integrator = IntegratorState::unpack(std::vector<double>(x.begin() + static_cast<long>(i), x.begin() + static_cast<long>(end)), -1);
   return s;
 }
 
@@ -219,9 +242,14 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
   if (from) {
     if (from->model != m.signature)
       throw std::invalid_argument("the state is of another model: it has " + from->model + "; this simulation " + m.signature);
-    if (!(from->time() >= 0 && from->time() < m.o.t_end))
-      throw std::invalid_argument("the state's time " + std::to_string(from->time()) + " s is not before simulation.t_end = " +
-                                  std::to_string(m.o.t_end) + " s");
+    if (!(from->time() >= 0))
+      throw std::invalid_argument(fmt::format("the state's time {:.6g} s is negative", from->time()));
+    if (!(from->time() < m.o.t_end))
+      throw std::invalid_argument(fmt::format("the state's time {:.10g} s is not before simulation.t_end = {:.10g} s: "
+                                              "nothing is left to run (a later t_end: --set simulation.t_end=…)",
+                                              from->time(), m.o.t_end));
+    // (a state put together by hand: its integrator's entries are checked where it is unpacked)
+    IntegratorState::unpack(from->integrator.pack(), -1);
     m.resume = from->integrator;
     m.resume.stats = {};
     // The outputs after the state's time, on this run's grid (the state's own row is written below).
@@ -234,8 +262,9 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
   if (!m.opts.output.empty()) {
     Parallelism p;
     p.threads = m.opts.threads;
-    m.file = std::make_unique<ResultsWriter>(  // (ResultsError for a path it cannot create)
-        m.opts.output, describe(cs, m.opts.made_by, "single", m.model->n(), p.max_threads(), m.opts.n));
+    FileDescription d = describe(cs, m.opts.made_by, "single", m.model->n(), p.max_threads(), m.opts.n);
+    d.driven_by = m.opts.driven_by;
+    m.file = std::make_unique<ResultsWriter>(m.opts.output, d);  // (ResultsError for a path it cannot create)
     m.recorder = std::make_unique<Hdf5Recorder>(*m.file);
     m.rq.observers.push_back(m.recorder.get());
   }
@@ -252,6 +281,13 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
   if (from) {
     m.apply_drives(from->drives);
     if (!from->laws.empty()) restore_law_memory(m.inputs, from->laws);  // (version 1: the laws start afresh)
+    if (!from->sensors.empty()) {  // (version < 3: the noise starts afresh)
+      const size_t half = from->sensors.size() / 2;
+      const std::vector<double> recorded(from->sensors.begin(), from->sensors.begin() + static_cast<long>(half));
+      if (from->sensors.size() % 2 != 0 || !m.sensors) throw std::invalid_argument("the state's sensors are not the case's");
+      m.book->restore_sensor_streams(recorded);
+      m.sensors->restore(std::vector<double>(from->sensors.begin() + static_cast<long>(half), from->sensors.end()));
+    }
   }  // (after the equations took the case laws' gains for Newton)
   if (m.eq->unknowns() == 0)
     throw CaseError(cs.path + ": joints: every joint follows a prescribed motion and there is no flexible link: nothing to step "
@@ -268,6 +304,12 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
       const IntegratorState& x = m.resume;
       if (!(*m.emit)(m.eq->sample(x.t, x.q.data(), x.v.data(), x.a.data(), x.dissipated, x.input_work)))
         m.status = m.emit->failure();
+      // A row the run the state came from did not record (its time is off the output grid) draws no
+      // noise from the streams the later rows share with that run.
+      const long k = m.resume.next_output - 1;
+      if (!from->sensors.empty() && !(k >= 0 && output_time(m.o, k) == x.t))
+        m.book->restore_sensor_streams(std::vector<double>(from->sensors.begin(),
+                                                           from->sensors.begin() + static_cast<long>(from->sensors.size() / 2)));
     }
   } catch (const std::invalid_argument&) {
     throw;  // a state that does not fit
@@ -357,9 +399,13 @@ RunStatus Simulation::advance(double t) {
   Impl& m = *impl_;
   m.require_running("advance");
   const double now = time();
+  // A time a round-off past t_end (a sum of sample times) is t_end.
+  if (t > m.o.t_end && t <= m.o.t_end * (1 + 1e-12)) t = m.o.t_end;
   if (!std::isfinite(t) || t < now || t > m.o.t_end)
-    throw std::invalid_argument("advance: t = " + std::to_string(t) + " s must lie between the simulation's time " +
-                                std::to_string(now) + " s and simulation.t_end = " + std::to_string(m.o.t_end) + " s");
+    throw std::invalid_argument(fmt::format("advance: t = {:.10g} s is {}: it must lie between the simulation's time {:.10g} s "
+                                            "and simulation.t_end = {:.10g} s",
+                                            t, !std::isfinite(t) ? "not finite" : t < now ? "in the past" : "after the run's end",
+                                            now, m.o.t_end));
   if (m.status.kind != RunStatus::Kind::Running || t == now) return m.status;
   try {
     m.bring_inputs_up_to_date();
@@ -419,6 +465,11 @@ SimulationState Simulation::state() const {
       d[4] = h->tau_ff;
     }
   s.laws = pack_law_memory(m.inputs);
+  if (m.sensors) {
+    s.sensors = m.book->sensor_streams(s.integrator.t);
+    const std::vector<double> snap = m.sensors->save();
+    s.sensors.insert(s.sensors.end(), snap.begin(), snap.end());
+  }
   return s;
 }
 
@@ -518,12 +569,22 @@ void Simulation::record_table(const std::string& name, const Table& table, const
 
 RunResult run_controlled(const Case& cs, SimulationOptions opts, const Controller& controller, const ControlOptions& c) {
   RFEM_CHECK_ARGUMENT(static_cast<bool>(controller), "no controller");
+  const double t_end = cs.sim.options.t_end;
+  const double t0 = opts.state ? opts.state->time() : 0.0;
   if (!(c.sample_time > 0) || !std::isfinite(c.sample_time))
-    throw std::invalid_argument("sample_time must be a positive number of seconds (got " + std::to_string(c.sample_time) + ")");
-  if (c.sample_time > cs.sim.options.t_end)
-    throw std::invalid_argument("sample_time = " + std::to_string(c.sample_time) + " s is longer than the run (simulation.t_end = " +
-                                std::to_string(cs.sim.options.t_end) + " s)");
-  if (c.delay < 0) throw std::invalid_argument("delay must be a whole number of samples ≥ 0 (got " + std::to_string(c.delay) + ")");
+    throw std::invalid_argument(fmt::format("sample_time must be a positive number of seconds (got {:.6g})", c.sample_time));
+  if (c.sample_time > t_end)
+    throw std::invalid_argument(fmt::format("sample_time = {:.6g} s is longer than the run (simulation.t_end = {:.6g} s)",
+                                            c.sample_time, t_end));
+  if (t_end / c.sample_time > kMaxOutputs)  // (every sample ends a step: 10⁸ steps at the least)
+    throw std::invalid_argument(fmt::format("sample_time = {:.3g} s gives {:.3g} samples over simulation.t_end = {:.6g} s "
+                                            "(at most {:.0e}): a longer sample time",
+                                            c.sample_time, t_end / c.sample_time, t_end, kMaxOutputs));
+  if (c.delay < 0) throw std::invalid_argument(fmt::format("delay must be a whole number of samples ≥ 0 (got {})", c.delay));
+  if (c.delay > 0 && static_cast<double>(c.delay) * c.sample_time >= t_end - t0)
+    throw std::invalid_argument(fmt::format("delay = {} samples ({:.6g} s) is not shorter than the run ({:.6g} s from t = {:.6g} s): "
+                                            "the controller would never act",
+                                            c.delay, c.delay * c.sample_time, t_end - t0, t0));
   Simulation sim(cs, std::move(opts));
   const Model& md = sim.model();
   const std::vector<std::string> kinds = sim.joint_inputs();
@@ -545,15 +606,20 @@ RunResult run_controlled(const Case& cs, SimulationOptions opts, const Controlle
     return sim.finish(s);
   };
   std::deque<ControlOutput> pending;
-  const double t_end = sim.t_end();
-  for (long k = 0;; ++k) {
+  // The samples t_k = k·sample_time from the start's time on (a state's time between two samples: to
+  // the next one under the state's held values first).
+  long k0 = static_cast<long>(std::ceil(t0 / c.sample_time * (1 - 1e-12)));
+  if (k0 * c.sample_time > t0 && sim.status().kind == RunStatus::Kind::Running)
+    sim.advance(std::min(k0 * c.sample_time, t_end));
+  std::string last;  // the last output that took effect, for a run that fails after it
+  for (long k = k0;; ++k) {
     const double tk = k * c.sample_time;
     if (tk >= t_end * (1 - 1e-12) || sim.status().kind != RunStatus::Kind::Running) break;
     ControlOutput u;
     try {
       u = controller(tk, sim.snapshot());
       for (const auto& [name, tau] : u.torques)
-        if (!std::isfinite(tau)) throw std::invalid_argument("joint '" + name + "': torque " + std::to_string(tau) + " is not finite");
+        if (!std::isfinite(tau)) throw std::invalid_argument(fmt::format("joint '{}': torque {} is not finite", name, tau));
       for (const auto& [name, r] : u.references)
         if (!std::isfinite(r.q) || !std::isfinite(r.v) || !std::isfinite(r.tau_ff))
           throw std::invalid_argument("joint '" + name + "': the reference is not finite");
@@ -562,6 +628,9 @@ RunResult run_controlled(const Case& cs, SimulationOptions opts, const Controlle
         const ControlOutput& out = pending.front();
         for (const auto& [name, tau] : out.torques) sim.set_torque(name, tau);
         for (const auto& [name, r] : out.references) sim.set_reference(name, r.q, r.v, r.tau_ff);
+        last = fmt::format("t = {:.6g} s:", tk);
+        for (const auto& [name, tau] : out.torques) last += fmt::format(" {} = {:.6g}", name, tau);
+        for (const auto& [name, r] : out.references) last += fmt::format(" {} = {:.6g} (reference)", name, r.q);
         for (size_t i = 0; i < recorded.size(); ++i) {
           const std::string& name = md.joints[recorded[i]].name;
           if (const auto it = out.torques.find(name); it != out.torques.end()) now[i] = it->second;
@@ -570,12 +639,15 @@ RunResult run_controlled(const Case& cs, SimulationOptions opts, const Controlle
         pending.pop_front();
       }
     } catch (const std::exception& e) {
-      return finish(RunStatus::failed(std::string("controller: ") + e.what() + " at t = " + std::to_string(tk) + " s"));
+      return finish(RunStatus::failed(fmt::format("controller: {} at t = {:.6g} s", e.what(), tk)));
     }
     record.data.push_back(tk);
     record.data.insert(record.data.end(), now.begin(), now.end());
     ++record.rows;
-    sim.advance(std::min((k + 1) * c.sample_time, t_end));
+    const RunStatus st = sim.advance(std::min((k + 1) * c.sample_time, t_end));
+    // A run that fails under the controller's output says which output it was under.
+    if (st.kind == RunStatus::Kind::Failed && !last.empty())
+      return finish(RunStatus::failed(st.reason + " (under the controller's output of " + last + ")"));
   }
   return finish(std::nullopt);
 }

@@ -29,6 +29,9 @@ struct SimulationState {
   std::vector<double> drives;
   /// What the joints' laws remember (pack_law_memory: a digital PD's held and delayed values).
   std::vector<double> laws;
+  /// Where the sensors' noise is (SensorBank::save): the recorded rows' streams (before the row at
+  /// the state's time, which a simulation started from it records again), then the snapshots'.
+  std::vector<double> sensors;
   double time() const { return integrator.t; }
   /// As doubles (a version first), and back (std::invalid_argument for text that is not one).
   std::vector<double> pack() const;
@@ -47,6 +50,9 @@ struct SimulationOptions {
   int threads = 0;           ///< the kernels' team (0: OpenMP's default)
   std::string output;        ///< results file ("": none)
   std::string made_by = "rfem::Simulation";  ///< kept in the file (command_line)
+  /// Who steps it, kept in the file (driven_by): `rfem run --resume` refuses a run whose inputs came
+  /// from its caller. "" for a case's own run (from a saved state: run_from_state).
+  std::string driven_by = "rfem::Simulation";
   bool keep_series = false;  ///< keep every series in memory (finish()'s RunResult::series)
   /// Start from this state instead of the case's initial state (its time; the results start there).
   std::shared_ptr<const SimulationState> state;

@@ -1,5 +1,7 @@
 #include "rfem/studies/validity.hpp"
 
+#include "rfem/core/positions.hpp"
+
 #include <stdexcept>
 
 #include <fmt/core.h>
@@ -33,6 +35,31 @@ void ValidityMonitor::check_joints(const VecX& q, const VecX& v, const VecX& tau
     note(speed_[static_cast<size_t>(j)], std::abs(xd) - l.velocity);
     note(effort_[static_cast<size_t>(j)], std::abs(tau[j]) - l.effort);
   }
+}
+
+std::string ValidityMonitor::diverged(const VecX& q, double t) const {
+  RFEM_CHECK_ARGUMENT_SIZE(q.size(), model_.dof(), "q");
+  for (Eigen::Index i = 0; i < q.size(); ++i)
+    if (!std::isfinite(q[i])) return fmt::format("diverged at t = {:.6g} s: coordinate {} is not finite", t, i);
+  for (size_t l = 0; l < model_.links.size(); ++l) {
+    const MountedLink& L = model_.links[l];
+    for (int k = 0; k < L.n(); ++k) {
+      const double phi = q.segment<3>(model_.rfe_index(static_cast<int>(l), k) + 3).cwiseAbs().maxCoeff();
+      if (phi > kDivergedRotation)
+        return fmt::format("diverged at t = {:.6g} s: link '{}': rfe {} turned {:.3g} rad relative to {{r}} (beyond {:.3g} rad: "
+                           "no small deformation left; an unstable loop or input?)",
+                           t, L.name, k + 1, phi, kDivergedRotation);
+    }
+    if (L.n() > 0) {
+      const Vec3 u = tip_deflection(model_, static_cast<int>(l), q);
+      const double off = std::hypot(u[0], u[1]), len = L.d.length;
+      if (len > 0 && off > kDivergedDeflection * len)
+        return fmt::format("diverged at t = {:.6g} s: link '{}': its tip is {:.3g} m off its undeformed place on a {:.3g} m link "
+                           "(an unstable loop or input?)",
+                           t, L.name, off, len);
+    }
+  }
+  return {};
 }
 
 void ValidityMonitor::check(const VecX& q, double t) {

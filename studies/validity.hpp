@@ -16,11 +16,20 @@ namespace rfem {
 /// The largest rotation of an rfe relative to {r} the model is trusted with [rad].
 inline constexpr double kSmallRotation = 0.1;
 
+/// An rfe turned this far relative to {r} [rad] (φ²/2 = 123 % error) or a link's tip this far
+/// from its undeformed place (in link lengths): not an approximate solution any more but a diverged
+/// one (an unstable controller, a loop that feeds energy in): the run ends (diverged()).
+inline constexpr double kDivergedRotation = 1.5707963267948966;
+inline constexpr double kDivergedDeflection = 1.0;
+
 class ValidityMonitor {
  public:
   explicit ValidityMonitor(const Model& model);
   /// Looks at a state (full coordinates) at time t (NaN for a static state).
   void check(const VecX& q, double t);
+  /// Why the state at t (full coordinates) is a diverged one ("diverged at t = … s: link 'L': …"),
+  /// or "" if it is not (kDivergedRotation, kDivergedDeflection; non-finite coordinates).
+  std::string diverged(const VecX& q, double t) const;
   /// Looks at the joints of an output sample against their rated limits (Joint::limits).
   void check_joints(const VecX& q, const VecX& v, const VecX& tau, double t);
   /// One warning per link whose rfes turned beyond kSmallRotation ("" context: "the solution"),

@@ -5,12 +5,15 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "rfem/results/writer.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/quantities.hpp"
 #include "rfem/studies/recorders.hpp"
 #include "rfem/studies/resume.hpp"
+#include "rfem/studies/simulation.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;
@@ -186,4 +189,91 @@ TEST(Resume, IntegratorStateRoundTripsAndRefusesAnotherModel) {
   std::vector<double> cut = s.pack();
   cut.pop_back();
   EXPECT_THROW(IntegratorState::unpack(cut, 5), std::invalid_argument);
+  // A damaged or edited state is refused naming its entry (not at the first step): a NaN
+  // coordinate, a NaN or fractional counter, a negative time.
+  const size_t head = s.pack_head().size();
+  auto refused = [&](size_t i, double value) {
+    std::vector<double> x = s.pack();
+    x[i] = value;
+    try {
+      IntegratorState::unpack(x, 5);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(refused(head, NAN).find("q[0] is not finite"), std::string::npos);
+  EXPECT_NE(refused(head + 5 + 2, INFINITY).find("v[2] is not finite"), std::string::npos);
+  EXPECT_NE(refused(10, NAN).find("steps"), std::string::npos);
+  EXPECT_NE(refused(9, 2.5).find("next_output"), std::string::npos);
+  EXPECT_NE(refused(1, -1.0).find("negative"), std::string::npos);
+  EXPECT_NE(refused(head - 1, 4.0).find("4 unknowns, the model 5"), std::string::npos);
+}
+
+// Nothing lost, nothing false (issue 52): a run with noisy sensors, stopped and resumed, has every
+// sensor row of the uninterrupted run, the same noise bit for bit (the checkpoint holds the
+// streams); a run stepped by its caller (a controller in the loop) is refused by resume, the file
+// left as it was.
+TEST(Resume, NoisySensorsResumeBitForBitAndASteppedRunIsRefused) {
+  std::string text;
+  {
+    std::ifstream in(test::source_path("cases/paper_deployment.toml"));
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  text += "\n[[sensors]]\nname = \"enc\"\nkind = \"encoder\"\njoint = \"psi3\"\nnoise = 1e-3\n";
+  const Case cs = parse_case(text, test::source_path("cases/paper_deployment.toml"), {"simulation.t_end=1.0"});
+  RunRequest whole;
+  whole.n = 6;
+  whole.threads = 1;
+  const std::vector<RunResult> ref = run_case(cs, whole);
+  ASSERT_EQ(ref.size(), 3u);
+  const std::string path = temp_file("sensors.h5");
+  {
+    const auto model = model_of(cs, 6);
+    ResultsWriter file(path, describe(cs, "test_resume", "paper", model->n(), 1, 6));
+    Hdf5Recorder recorder(file);
+    RunRequest rq;
+    rq.n = 6;
+    rq.threads = 1;
+    rq.checkpoint_interval = 1e-9;
+    StopAt stop(rq.stop, "kinematic", 40);
+    rq.observers = {&recorder, &stop};
+    const std::vector<RunResult> runs = run_case(cs, model, joint_inputs(cs, {}), rq);
+    ASSERT_EQ(runs.back().status.kind, RunStatus::Kind::Interrupted);
+    file.close();
+  }
+  RunRequest rq;
+  rq.threads = 1;
+  const std::vector<RunResult> rest = resume_case(plan_resume(path), rq);
+  ASSERT_EQ(rest.size(), 2u);
+  const ResultsReader in(path);
+  for (size_t r = 0; r < 2; ++r) {
+    const RunResult& a = ref[r + 1];
+    ASSERT_TRUE(rest[r].completed()) << rest[r].status;
+    const Table file_rows = in.table(a.name + "/sensors");
+    EXPECT_EQ(file_rows.rows, a.sensors.rows) << a.name;
+    EXPECT_TRUE(file_rows.data == a.sensors.data) << a.name << ": the sensor rows differ from the uninterrupted run's";
+    EXPECT_TRUE(rest[r].sensors.data == a.sensors.data) << a.name << ": the resumed run's own sensor rows";
+  }
+  std::filesystem::remove(path);
+
+  // A stepped run's file (rfem::Simulation) is not resumed: its inputs are not in the file.
+  const std::string stepped = temp_file("stepped.h5");
+  {
+    SimulationOptions o;
+    o.threads = 1;
+    o.output = stepped;
+    o.n = 6;
+    Simulation s(cs, o);
+    s.advance(0.1);
+  }
+  const auto before = std::filesystem::last_write_time(stepped);
+  try {
+    plan_resume(stepped);
+    ADD_FAILURE() << "a stepped run's file was accepted for resume";
+  } catch (const CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("stepped by rfem::Simulation"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(std::filesystem::last_write_time(stepped), before);
+  std::filesystem::remove(stepped);
 }

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "rfem/results/reader.hpp"
 #include "rfem/studies/sensors.hpp"
@@ -467,4 +469,80 @@ TEST(Simulation, TheEnergyBooksBalanceWithATorqueHeldOnAPdJoint) {
   std::snprintf(buf, sizeof buf, "%.3e", r.energy_drift / r.energy_scale);
   RecordProperty("energy_drift_relative", buf);
   EXPECT_LT(r.energy_drift, 1e-6 * r.energy_scale);
+}
+
+// Nothing lost, nothing false (issue 52): the noise of the recorded sensors is part of a state, so a
+// simulation started from it records what the original run recorded, bit for bit, whether the state
+// was taken on the output grid or between two outputs (whose own row then draws no shared noise).
+TEST(Simulation, NoisySensorsGoOnBitForBitFromAStateOnAndOffTheGrid) {
+  std::string text;
+  {
+    std::ifstream in(test::source_path("cases/kane_hub_drive.toml"));
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  text += "\n[[sensors]]\nname = \"enc\"\nkind = \"encoder\"\njoint = \"hub\"\nnoise = 1e-3\n";
+  const Case cs = parse_case(text, test::source_path("cases/kane_hub_drive.toml"),
+                             {"simulation.t_end=0.4", "link.n=6", "simulation.output_dt=0.01"});
+  for (const double at : {0.2, 0.173}) {
+    Simulation a(cs, one_thread());
+    a.advance(at);
+    SimulationOptions o = one_thread();
+    o.state = std::make_shared<const SimulationState>(a.state());
+    a.advance(0.4);
+    const RunResult ra = a.finish();
+    Simulation b(cs, o);
+    b.advance(0.4);
+    const RunResult rb = b.finish();
+    ASSERT_EQ(ra.sensors.cols, 3);  // time, enc/q, enc/qd
+    ASSERT_GT(rb.sensors.rows, 10);
+    // Row by row from the end: the same time, the same noisy readings.
+    for (long k = 1; k <= rb.sensors.rows - (at == 0.2 ? 0 : 1); ++k)
+      for (long c = 0; c < 3; ++c)
+        ASSERT_EQ(ra.sensors.at(ra.sensors.rows - k, c), rb.sensors.at(rb.sensors.rows - k, c)) << "state at " << at << ", row −" << k;
+    // (and the noise is there: the reading is not the exact joint angle)
+    EXPECT_NE(ra.sensors.at(ra.sensors.rows - 1, 1), series(ra, "joint_q").at(ra.sensors.rows - 1, 0));
+  }
+}
+
+// A closed loop that feeds energy in (positive feedback on the hub's rate) ends as diverged within
+// its first simulated second, not "completed" after hundreds of thousands of steps.
+TEST(Simulation, ADivergingLoopEndsDivergedWithItsRowsKept) {
+  const Case cs = hub(1.0);
+  const RunResult r = run_controlled(cs, one_thread(), [](double, const Snapshot& y) {
+    ControlOutput u;
+    u.torques["hub"] = 1e5 * y.joint_v[0] + 1e3;
+    return u;
+  }, ControlOptions{0.01, 0});
+  ASSERT_EQ(r.status.kind, RunStatus::Kind::Failed) << r.status;
+  EXPECT_EQ(r.status.reason.rfind("diverged at t = ", 0), 0u) << r.status;
+  EXPECT_LT(r.t_reached, 1.0);
+  EXPECT_LT(r.stats.steps, 50000);
+  EXPECT_GT(r.samples, 1);
+  EXPECT_EQ(series(r, "time").rows, r.samples);
+}
+
+// A controller started from a state later than its first sample time samples from the state's time on.
+TEST(Simulation, AControllerStartsFromAStatesTime) {
+  const Case cs = hub(0.3);
+  Simulation s(cs, one_thread());
+  s.advance(0.105);
+  SimulationOptions o = one_thread();
+  o.state = std::make_shared<const SimulationState>(s.state());
+  std::vector<double> called;
+  const RunResult r = run_controlled(cs, o, [&](double t, const Snapshot& y) {
+    EXPECT_EQ(t, y.t);
+    called.push_back(t);
+    ControlOutput u;
+    u.torques["hub"] = 200.0;
+    return u;
+  }, ControlOptions{0.01, 0});
+  ASSERT_TRUE(r.completed()) << r.status;
+  ASSERT_FALSE(called.empty());
+  EXPECT_NEAR(called.front(), 0.11, 1e-12);  // the first sample after the state's time
+  EXPECT_NEAR(called.back(), 0.29, 1e-12);
+  // Bad sample times and delays are refused before the run.
+  EXPECT_THROW(run_controlled(cs, one_thread(), [](double, const Snapshot&) { return ControlOutput{}; }, ControlOptions{1e-300, 0}),
+               std::invalid_argument);
+  EXPECT_THROW(run_controlled(cs, one_thread(), [](double, const Snapshot&) { return ControlOutput{}; }, ControlOptions{0.01, 1000000}),
+               std::invalid_argument);
 }

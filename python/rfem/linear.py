@@ -42,9 +42,15 @@ class LinearFile:
                         import scipy.sparse as sp
                         t = d[()]
                         shape = (len(d.attrs["rows"]), len(d.attrs["matrix_columns"]))
+                        _check_triplets(self.path, name, t, shape)
                         setattr(self, name, sp.csc_matrix((t[:, 2], (t[:, 0].astype(int), t[:, 1].astype(int))), shape=shape))
                     else:  # a table (older files held M, D, K, B as tables too)
-                        setattr(self, name, _sparse(d[()]) if name in ("M", "D", "K", "B") else d[()])
+                        a = d[()]
+                        bad = np.argwhere(~np.isfinite(a))
+                        if len(bad):
+                            raise LinearError(f"{self.path}: linear/{name}: entry {tuple(int(i) for i in bad[0])} is not finite "
+                                              f"({len(bad)} such): a damaged file (write it again with rfem linearize -o)")
+                        setattr(self, name, _sparse(a) if name in ("M", "D", "K", "B") else a)
                 about = g.attrs["about"]
                 self.equilibrium = (about.decode() if isinstance(about, bytes) else str(about)) == "equilibrium"
                 t = g.attrs["t"]
@@ -55,6 +61,24 @@ class LinearFile:
     def __repr__(self):
         return (f"<rfem.linear.LinearFile {self.path}: {len(self.states)} states, {len(self.inputs)} inputs, "
                 f"{len(self.outputs)} outputs>")
+
+
+def _check_triplets(path, name, t, shape):
+    """A sparse matrix's (row, column, value) triplets: whole, in range, finite; else one LinearError line."""
+    if t.ndim != 2 or t.shape[1] != 3:
+        raise LinearError(f"{path}: linear/{name}: not a table of (row, column, value) triplets")
+    for k, what in ((0, "row"), (1, "column")):
+        i = t[:, k]
+        ok = np.isfinite(i) & (i == np.round(i)) & (i >= 0) & (i < shape[k])
+        if not ok.all():
+            j = int(np.argmin(ok))
+            raise LinearError(f"{path}: linear/{name}: triplet {j} has {what} index {i[j]!r}, not a whole number "
+                              f"from 0 to {shape[k] - 1}: a damaged file (write it again with rfem linearize -o)")
+    bad = np.flatnonzero(~np.isfinite(t[:, 2]))
+    if len(bad):
+        j = int(bad[0])
+        raise LinearError(f"{path}: linear/{name}: the value at ({int(t[j, 0])}, {int(t[j, 1])}) is not finite "
+                          f"({len(bad)} such): a damaged file (write it again with rfem linearize -o)")
 
 
 def _sparse(a):
@@ -167,7 +191,7 @@ def main(argv=None):
         G = np.abs(frequency_response(lin, f, args.input, args.output))
         print("wrote %s" % out)
         print("largest |G| = %.6g at %.6g Hz" % (G.max(), f[np.argmax(G)]))
-    except (LinearError, OSError, ValueError) as exc:
+    except (LinearError, OSError, ValueError, RuntimeError, ArithmeticError) as exc:  # (scipy's singular matrix too)
         print("rfem bode: error: %s" % str(exc).splitlines()[0], file=sys.stderr)
         return 2
     return 0

@@ -57,7 +57,8 @@ class Simulation:
     time, t_end [s]; q, v: every coordinate and rate in the model's order (numpy), named by
     coordinate_names (LINK/rfeK/x1 … phi3, then the joints); joint_names, joint_inputs ("motion",
     "torque" or "feedback"). The integrator is ESDIRK (simulation.integrator = "bdf" is refused).
-    Not thread-safe: one thread steps a simulation."""
+    One thread at a time: a call from a second thread while another is inside (advance releases the
+    GIL) raises RuntimeError; finish() or leaving `with` closes and unlocks the results file."""
 
     def __init__(self, case, n=None, output=None, state=None, threads=0, keep_series=True):
         # (the arguments are checked by the module: TypeError, ValueError naming them)

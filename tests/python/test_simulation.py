@@ -179,3 +179,54 @@ def test_a_runs_sensors_in_memory_are_its_files_and_tip_motion_is_consistent():
     fd = (p[2:] - p[:-2]) / (2 * h)
     assert np.abs(fd - v[1:-1]).max() < 1e-3 * np.abs(v).max()
     np.testing.assert_allclose(np.linalg.norm(y[:, 6:9], axis=1), np.linalg.norm(a, axis=1), rtol=1e-12, atol=1e-12)
+
+
+def test_one_simulation_from_two_threads_is_refused_not_a_crash():
+    """Issue 52: a Simulation entered by a second thread while the first advances (the GIL released)
+    raises RuntimeError in that thread; the first one's run goes on untouched."""
+    import threading
+    sim = rfem.Simulation(hub(t_end=2.0, n=20), threads=1)
+    errors, done = [], []
+
+    def go(k):
+        try:
+            for _ in range(40):
+                sim.advance(min(sim.t_end, sim.time + 0.05))
+                sim.set_torque("hub", 100.0 + k)
+                sim.snapshot()
+            done.append(k)
+        except RuntimeError as e:
+            errors.append(str(e))
+    threads = [threading.Thread(target=go, args=(k,)) for k in range(2)]
+    [t.start() for t in threads]
+    [t.join() for t in threads]
+    assert done or errors
+    assert all("in use by another thread" in e for e in errors), errors
+    assert sim.finish().status in ("completed", "interrupted (stopped)")
+
+
+def test_controller_outputs_and_pickles_are_checked_in_rfems_words(tmp_path):
+    """Issue 52: a controller's array of two values is a TypeError naming the joint; numpy float32 is a
+    number; a tampered pickle is a ValueError, never pybind11's cast message; a huge signal number
+    does not wrap."""
+    case = hub(t_end=0.2)
+    with pytest.raises(TypeError, match=r"joint 'hub': expected a number, got ndarray of shape \(2,\)"):
+        rfem.run_controlled(case, lambda t, y: {"hub": np.array([1.0, 2.0])}, 0.01)
+    r = rfem.run_controlled(case, lambda t, y: {"hub": np.float32(200.0)}, 0.01)
+    assert r.status == "completed"
+    s = rfem.Simulation(case)
+    s.set_torque("hub", np.float32(2.0))
+    s.finish()
+    st = list(case.__getstate__())
+    st[1] = None
+    c = rfem.Case.__new__(rfem.Case)
+    with pytest.raises(ValueError, match="not a pickled rfem.Case"):
+        c.__setstate__(tuple(st))
+    run = rfem.run(case, threads=1)["run"]
+    st = list(run.__getstate__())
+    st[6] = -1
+    o = rfem.Run.__new__(rfem.Run)
+    with pytest.raises(ValueError, match="outputs = -1 is negative"):
+        o.__setstate__(tuple(st))
+    assert rfem.RunStatus.parse("interrupted (signal 99999999999)").signal in (None, 0)
+    assert rfem.RunStatus.parse("interrupted (signal 15)").signal == 15
