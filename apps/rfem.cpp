@@ -12,6 +12,7 @@
 #include <omp.h>
 
 #include "commands.hpp"
+#include "rfem/assembly/workspace.hpp"
 #include "rfem/results/errors.hpp"
 #include "rfem/version.hpp"
 
@@ -208,6 +209,10 @@ int main(int argc, char** argv) {
   // EIGEN_DONT_PARALLELIZE), and no call the program makes uses more than --threads, whether it is
   // passed them or not.
   if (common.threads > 0) omp_set_num_threads(common.threads);
+  // More threads than cores: said once (an MPI sweep's ranks are counted where they run).
+  if (common.threads > 0)
+    if (const std::string w = rfem::oversubscription(1, common.threads, "--threads " + std::to_string(common.threads)); !w.empty())
+      print_warning(w);
   spdlog::set_default_logger(spdlog::stderr_logger_mt("rfem"));
   spdlog::set_pattern("[%H:%M:%S.%e] %v");
   spdlog::set_level(common.verbose ? spdlog::level::debug : spdlog::level::warn);

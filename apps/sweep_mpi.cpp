@@ -16,6 +16,7 @@
 
 #include "commands.hpp"
 #include "signals.hpp"
+#include "rfem/assembly/workspace.hpp"
 #include "rfem/results/errors.hpp"
 #include "rfem/studies/sweep.hpp"
 
@@ -184,6 +185,21 @@ int run_sweep_mpi(const SweepOptions& o, bool json, bool quiet) {
   int rank = 0, ranks = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  {  // Ranks beyond this node's cores (each point runs one thread): the node's first rank says so.
+    MPI_Comm node;
+    int local = 1, local_rank = 0;
+    if (MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, &node) == MPI_SUCCESS) {
+      MPI_Comm_size(node, &local);
+      MPI_Comm_rank(node, &local_rank);
+      MPI_Comm_free(&node);
+    }
+    // (rank 0 coordinates and waits: it runs no point, so the workers on its node are one fewer)
+    const int workers = local - (rank == 0 ? 1 : 0);
+    if (local_rank == 0 && !quiet)
+      if (const std::string w = oversubscription(workers, 1, std::to_string(workers) + " MPI ranks running points on this node");
+          !w.empty())
+        print_warning(w);
+  }
   StopToken stop;
   int code = 0;
   {

@@ -1,6 +1,7 @@
 #include "rfem/assembly/assemble.hpp"
 
 #include <omp.h>
+#include <sched.h>
 
 #include <algorithm>
 
@@ -16,6 +17,21 @@ int Parallelism::team(int n) const {
 }
 
 int Parallelism::max_threads() const { return threads > 0 ? threads : omp_get_max_threads(); }
+
+int available_cores() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof set, &set) == 0) return std::max(1, CPU_COUNT(&set));
+  return std::max(1, omp_get_num_procs());
+}
+
+std::string oversubscription(int processes, int threads_each, const std::string& who) {
+  const int cores = available_cores();
+  const long want = static_cast<long>(std::max(1, processes)) * std::max(1, threads_each);
+  if (want <= cores) return {};
+  return who + ": " + std::to_string(want) + " threads on " + std::to_string(cores) + " core" + (cores > 1 ? "s" : "") +
+         ": they take turns (each waits for a core; " + std::to_string(cores) + " would run as fast)";
+}
 
 void Workspace::bind(const Model& model) {
   bound_rfes_ = model.n();

@@ -4,11 +4,20 @@
 // Model/Data split of Pinocchio). Per-rfe loops run over fixed chunks of rfes whose partial sums
 // are combined in chunk order, so results are the same bits for any number of threads.
 #include <algorithm>
+#include <string>
 #include <vector>
 
 #include "rfem/core/kinematics.hpp"
 
 namespace rfem {
+
+/// The cores this process may run on (its CPU affinity: a container's or a batch job's share, not
+/// the machine's).
+int available_cores();
+/// A warning if `processes` × `threads_each` threads would share fewer cores ("" if they fit), in
+/// the words of `who` ("--threads 4", "--jobs 4", "4 MPI ranks on this node"): threads that wait for
+/// a core at every barrier run slower than fewer threads would.
+std::string oversubscription(int processes, int threads_each, const std::string& who);
 
 /// How many threads the per-rfe loops use.
 struct Parallelism {

@@ -8,6 +8,9 @@ namespace {
 constexpr size_t kSamples = 12;      // units of work compared per team
 constexpr double kProbeFirst = 0.5, kProbeMax = 8.0;  // s of work on the chosen team between probes
 constexpr double kMargin = 0.9;      // a challenger must be 10 % faster to take over
+// A fixed team falls back to one thread only if that is 25 % faster, and comes back once it is not
+// slower: timing noise on an idle machine never moves it.
+constexpr double kFixedMargin = 0.8;
 
 // The mean, not the median: when another process shares a core, a team's steps are now fast, now
 // stalled for a time slice; throughput is what counts.
@@ -19,8 +22,9 @@ double mean(const std::vector<double>& v) {
 }  // namespace
 
 ThreadGovernor::ThreadGovernor(int max_threads, bool fixed)
-    : max_(std::max(1, max_threads)), current_(max_), best_(max_), adaptive_(!fixed && max_ > 1), probe_every_(kProbeFirst) {
-  if (adaptive_) probing_ = kSamples + 1;  // time the full team first, then one thread
+    : max_(std::max(1, max_threads)), current_(max_), best_(max_), adaptive_(max_ > 1), fixed_(fixed), probe_every_(kProbeFirst) {
+  // Time the full team first, then one thread (a fixed team: one thread at the first probe only).
+  if (adaptive_ && !fixed_) probing_ = kSamples + 1;
 }
 
 void ThreadGovernor::record(double seconds) {
@@ -50,10 +54,16 @@ void ThreadGovernor::record(double seconds) {
     return;
   }
   const double mine = mean(sample_[slot]), theirs = mean(sample_[other]);
-  const bool incumbent = (best_ > 1) == (slot == 1);
-  const bool keep_mine = incumbent ? mine <= theirs / kMargin : mine < kMargin * theirs;
   const int before = best_;
-  best_ = keep_mine ? current_ : (other ? max_ : 1);
+  if (fixed_) {
+    const double one = slot == 0 ? mine : theirs, team = slot == 1 ? mine : theirs;
+    const bool team_wins = best_ > 1 ? !(one < kFixedMargin * team) : team <= one;
+    best_ = team_wins ? max_ : 1;
+  } else {
+    const bool incumbent = (best_ > 1) == (slot == 1);
+    const bool keep_mine = incumbent ? mine <= theirs / kMargin : mine < kMargin * theirs;
+    best_ = keep_mine ? current_ : (other ? max_ : 1);
+  }
   current_ = best_;
   since_probe_ = 0.0;
   probe_every_ = best_ == before ? std::min(kProbeMax, 2 * probe_every_) : kProbeFirst;

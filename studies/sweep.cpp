@@ -17,6 +17,8 @@
 #include <numeric>
 #include <thread>
 
+#include "rfem/assembly/workspace.hpp"
+
 #include "rfem/cases/case_reading_impl.hpp"
 #include "rfem/core/check.hpp"
 #include "rfem/results/errors.hpp"
@@ -415,7 +417,9 @@ std::vector<SweepRow> run_sweep(const Sweep& s, const SweepRequest& rq, const Sw
   for (const SweepRow& r : rows)
     if (!r.pending()) ++(r.completed() ? pr.done : pr.failed);
   write_index(s, rows);
-  const int jobs = std::max(1, std::min(rq.jobs > 0 ? rq.jobs : static_cast<int>(std::thread::hardware_concurrency()), static_cast<int>(todo.size())));
+  const int jobs = std::max(1, std::min(rq.jobs > 0 ? rq.jobs : available_cores(), static_cast<int>(todo.size())));
+  if (rq.warn)
+    if (const std::string w = oversubscription(jobs, 1, "sweep: --jobs " + std::to_string(jobs)); !w.empty()) rq.warn(w);
   std::mutex lock;
   std::atomic<size_t> next{0};
   std::exception_ptr error;
