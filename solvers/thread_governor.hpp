@@ -37,6 +37,8 @@ class ThreadGovernor {
   double since_probe_ = 0.0;       // wall time since the last probe [s]
   double probe_every_ = 0.5;       // [s], doubled after each lost challenge
   int probing_ = 0;                // evaluations left in the current probe
+  double probe_sum_ = 0.0;         // the current probe's timed evaluations: their sum and count
+  int probe_timed_ = 0;
 };
 
 }  // namespace rfem

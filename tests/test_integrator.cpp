@@ -165,6 +165,12 @@ TEST(ThreadGovernor, PicksTheFasterTeamAndKeepsChecking) {
   EXPECT_EQ(fixed.threads(), 1) << "a fixed team under foreign load must fall back to one thread";
   for (int i = 0; i < 40000 && fixed.threads() != 2; ++i) fixed.record(cost(fixed.threads(), false));
   EXPECT_EQ(fixed.threads(), 2) << "and come back to the team once the machine is idle";
+  // A team far slower than one thread (a time slice lost at every barrier) is given up after its
+  // first two timed evaluations, not thirteen.
+  ThreadGovernor heavy(2, true);
+  for (int i = 0; i < 200; ++i) heavy.record(heavy.threads() > 1 ? 30e-3 : 1e-3);
+  EXPECT_EQ(heavy.threads(), 1);
+  EXPECT_LE(heavy.evaluations(2), 3);
   ThreadGovernor one(1, true);
   for (int i = 0; i < 100; ++i) one.record(1e-3);
   EXPECT_EQ(one.threads(), 1);
