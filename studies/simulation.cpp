@@ -281,10 +281,11 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
   if (from) {
     m.apply_drives(from->drives);
     if (!from->laws.empty()) restore_law_memory(m.inputs, from->laws);  // (version 1: the laws start afresh)
-    if (!from->sensors.empty()) {  // (version < 3: the noise starts afresh)
+    // (version < 3: the noise starts afresh; a case without sensors has none to go on with)
+    if (!from->sensors.empty() && m.sensors) {
       const size_t half = from->sensors.size() / 2;
       const std::vector<double> recorded(from->sensors.begin(), from->sensors.begin() + static_cast<long>(half));
-      if (from->sensors.size() % 2 != 0 || !m.sensors) throw std::invalid_argument("the state's sensors are not the case's");
+      if (from->sensors.size() % 2 != 0) throw std::invalid_argument("the state's sensors' noise is damaged (an odd count)");
       m.book->restore_sensor_streams(recorded);
       m.sensors->restore(std::vector<double>(from->sensors.begin() + static_cast<long>(half), from->sensors.end()));
     }
@@ -307,7 +308,7 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
       // A row the run the state came from did not record (its time is off the output grid) draws no
       // noise from the streams the later rows share with that run.
       const long k = m.resume.next_output - 1;
-      if (!from->sensors.empty() && !(k >= 0 && output_time(m.o, k) == x.t))
+      if (!from->sensors.empty() && m.sensors && !(k >= 0 && output_time(m.o, k) == x.t))
         m.book->restore_sensor_streams(std::vector<double>(from->sensors.begin(),
                                                            from->sensors.begin() + static_cast<long>(from->sensors.size() / 2)));
     }
