@@ -71,6 +71,9 @@ IntegratorState IntegratorState::unpack(const std::vector<double>& x, int unknow
                                             "residual_evals", "factorizations", "newton_iters", "newton_fails",
                                             "error_test_fails", "last_step"};
   for (size_t i = 1; i < head - 1; ++i) {
+    // (h may be +inf: between a caller's frequent stops the step controller's proposal grows without
+    // bound while every step lands on the next stop; the next step is cut to its stop all the same)
+    if (i == 2 && x[i] == INFINITY) continue;
     if (!std::isfinite(x[i])) throw std::invalid_argument(std::string("the state's ") + names[i] + " is not finite");
     if (i >= 9 && i <= 15) whole(i, names[i]);
   }

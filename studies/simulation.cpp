@@ -107,8 +107,8 @@ SimulationState SimulationState::unpack(const std::string& model, const std::vec
   }
   for (double d : s.drives)
     if (!std::isfinite(d)) throw std::invalid_argument("the state's held drive values are not finite");
-  for (double d : s.laws)
-    if (!std::isfinite(d)) throw std::invalid_argument("the state's memory of the joints' laws is not finite");
+  for (double d : s.laws)  // (a digital law that has not sampled yet remembers its last sample at −inf)
+    if (std::isnan(d)) throw std::invalid_argument("the state's memory of the joints' laws holds NaN");
   s.integrator = IntegratorState::unpack(std::vector<double>(x.begin() + static_cast<long>(i), x.begin() + static_cast<long>(end)), -1);
   return s;
 }

@@ -207,6 +207,8 @@ TEST(Resume, IntegratorStateRoundTripsAndRefusesAnotherModel) {
   EXPECT_NE(refused(10, NAN).find("steps"), std::string::npos);
   EXPECT_NE(refused(9, 2.5).find("next_output"), std::string::npos);
   EXPECT_NE(refused(1, -1.0).find("negative"), std::string::npos);
+  EXPECT_NE(refused(2, NAN).find("h is not finite"), std::string::npos);
+  EXPECT_EQ(refused(2, INFINITY), "accepted");  // (a controller's frequent stops let the proposal grow unbounded)
   EXPECT_NE(refused(head - 1, 4.0).find("4 unknowns, the model 5"), std::string::npos);
 }
 
