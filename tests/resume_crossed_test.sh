@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Resume crossed with what a run writes besides its series (issue 52): a run with noisy sensors and a
+# Resume crossed with what a run writes besides its series: a run with noisy sensors and a
 # run with a reduced link, each killed (SIGKILL) at a tenth, two fifths and three quarters of its outputs and resumed,
 # end with every dataset bit for bit that of the uninterrupted run (sensor rows and their noise
 # included); a run stepped by a Python controller and a run started from a saved state, killed,

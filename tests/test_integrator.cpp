@@ -143,7 +143,7 @@ TEST(ThreadGovernor, PicksTheFasterTeamAndKeepsChecking) {
   for (int i = 0; i < 3000; ++i) g.record(cost(g.threads(), true));
   EXPECT_GT(g.evaluations(1), before + 2000) << "and one thread stays the choice while it is faster";
   EXPECT_GT(g.evaluations(2), 100) << "while two threads are still tried now and then";
-  // Fixed by the user (issue 55): the team is kept on an idle machine — even where one thread would
+  // Fixed by the user: the team is kept on an idle machine — even where one thread would
   // be 10 % faster (timing noise, a small n) — and falls back to one thread only under foreign load
   // (the team 3× slower at every barrier), coming back once the machine is idle again.
   ThreadGovernor fixed(2, true);

@@ -212,7 +212,7 @@ TEST(Resume, IntegratorStateRoundTripsAndRefusesAnotherModel) {
   EXPECT_NE(refused(head - 1, 4.0).find("4 unknowns, the model 5"), std::string::npos);
 }
 
-// Nothing lost, nothing false (issue 52): a run with noisy sensors, stopped and resumed, has every
+// A run with noisy sensors, stopped and resumed, has every
 // sensor row of the uninterrupted run, the same noise bit for bit (the checkpoint holds the
 // streams); a run stepped by its caller (a controller in the loop) is refused by resume, the file
 // left as it was.

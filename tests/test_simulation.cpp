@@ -471,7 +471,7 @@ TEST(Simulation, TheEnergyBooksBalanceWithATorqueHeldOnAPdJoint) {
   EXPECT_LT(r.energy_drift, 1e-6 * r.energy_scale);
 }
 
-// Nothing lost, nothing false (issue 52): the noise of the recorded sensors is part of a state, so a
+// The noise of the recorded sensors is part of a state, so a
 // simulation started from it records what the original run recorded, bit for bit, whether the state
 // was taken on the output grid or between two outputs (whose own row then draws no shared noise).
 TEST(Simulation, NoisySensorsGoOnBitForBitFromAStateOnAndOffTheGrid) {

@@ -182,7 +182,7 @@ def test_a_runs_sensors_in_memory_are_its_files_and_tip_motion_is_consistent():
 
 
 def test_one_simulation_from_two_threads_is_refused_not_a_crash():
-    """Issue 52: a Simulation entered by a second thread while the first advances (the GIL released)
+    """A Simulation entered by a second thread while the first advances (the GIL released)
     raises RuntimeError in that thread; the first one's run goes on untouched."""
     import threading
     sim = rfem.Simulation(hub(t_end=2.0, n=20), threads=1)
@@ -206,7 +206,7 @@ def test_one_simulation_from_two_threads_is_refused_not_a_crash():
 
 
 def test_controller_outputs_and_pickles_are_checked_in_rfems_words(tmp_path):
-    """Issue 52: a controller's array of two values is a TypeError naming the joint; numpy float32 is a
+    """A controller's array of two values is a TypeError naming the joint; numpy float32 is a
     number; a tampered pickle is a ValueError, never pybind11's cast message; a huge signal number
     does not wrap."""
     case = hub(t_end=0.2)
