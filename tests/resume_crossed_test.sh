@@ -28,12 +28,8 @@ import h5py, numpy as np
 
 rfem, src = os.environ["RFEM"], os.environ["SRC"]
 checks = {}
-
-def datasets(path):
-    out = {}
-    with h5py.File(path, "r") as f:
-        f.visititems(lambda k, v: out.__setitem__(k, v[()]) if isinstance(v, h5py.Dataset) else None)
-    return out
+sys.path.insert(0, os.environ["SRC"] + "/tests")
+from results_files import datasets  # noqa: E402
 
 def md5(path):
     return hashlib.md5(open(path, "rb").read()).hexdigest()

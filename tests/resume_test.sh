@@ -17,12 +17,8 @@ import h5py, numpy as np
 rfem, case, n = os.environ["RFEM"], os.environ["SRC"] + "/cases/kane_spinup.toml", os.environ["N"]
 every = "0.2"  # s of wall time between checkpoints
 checks = {}
-
-def datasets(path):
-    out = {}
-    with h5py.File(path, "r") as f:
-        f.visititems(lambda k, v: out.__setitem__(k, v[()]) if isinstance(v, h5py.Dataset) else None)
-    return out
+sys.path.insert(0, os.environ["SRC"] + "/tests")
+from results_files import datasets  # noqa: E402
 
 def checkpoints(path):  # how many checkpoints the run has written (read as SWMR while it goes)
     try:
