@@ -1,0 +1,100 @@
+// A digital controller in the loop (studies/simulation.hpp: run_controlled): a loop over a
+// Simulation's advance(), the controller's output held from its sample (zero-order hold) and
+// recorded in the run's group (run/control).
+#include <cmath>
+#include <deque>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "rfem/core/check.hpp"
+#include "rfem/studies/simulation.hpp"
+
+namespace rfem {
+
+RunResult run_controlled(const Case& cs, SimulationOptions opts, const Controller& controller, const ControlOptions& c) {
+  RFEM_CHECK_ARGUMENT(static_cast<bool>(controller), "no controller");
+  const double t_end = cs.sim.options.t_end;
+  const double t0 = opts.state ? opts.state->time() : 0.0;
+  if (!(c.sample_time > 0) || !std::isfinite(c.sample_time))
+    throw std::invalid_argument(fmt::format("sample_time must be a positive number of seconds (got {:.6g})", c.sample_time));
+  if (c.sample_time > t_end)
+    throw std::invalid_argument(fmt::format("sample_time = {:.6g} s is longer than the run (simulation.t_end = {:.6g} s)",
+                                            c.sample_time, t_end));
+  if (t_end / c.sample_time > kMaxOutputs)  // (every sample ends a step: 10⁸ steps at the least)
+    throw std::invalid_argument(fmt::format("sample_time = {:.3g} s gives {:.3g} samples over simulation.t_end = {:.6g} s "
+                                            "(at most {:.0e}): a longer sample time",
+                                            c.sample_time, t_end / c.sample_time, t_end, kMaxOutputs));
+  if (c.delay < 0) throw std::invalid_argument(fmt::format("delay must be a whole number of samples ≥ 0 (got {})", c.delay));
+  if (c.delay > 0 && static_cast<double>(c.delay) * c.sample_time >= t_end - t0)
+    throw std::invalid_argument(fmt::format("delay = {} samples ({:.6g} s) is not shorter than the run ({:.6g} s from t = {:.6g} s): "
+                                            "the controller would never act",
+                                            c.delay, c.delay * c.sample_time, t_end - t0, t0));
+  Simulation sim(cs, std::move(opts));
+  const Model& md = sim.model();
+  const std::vector<std::string> kinds = sim.joint_inputs();
+  // The record: per sample, the time and each force-input joint's held torque or reference (NaN:
+  // the case's law).
+  std::vector<std::string> columns = {"time"}, units = {"s"};
+  std::vector<int> recorded;
+  for (int j = 0; j < md.m(); ++j)
+    if (kinds[j] != "motion") {
+      columns.push_back(md.joints[j].name);
+      units.push_back(kinds[j] == "feedback" ? "q_ref or N m" : "N m or N");
+      recorded.push_back(j);
+    }
+  Table record{0, static_cast<long>(columns.size()), {}};
+  std::vector<double> now(recorded.size(), NAN);
+  auto finish = [&](std::optional<RunStatus> s) {
+    sim.record_table("control", record, columns, units,
+                     "the controller's outputs in effect from each sample time (zero-order hold; NaN: the case's law)");
+    return sim.finish(s);
+  };
+  std::deque<ControlOutput> pending;
+  // The samples t_k = k·sample_time from the start's time on (a state's time between two samples: to
+  // the next one under the state's held values first).
+  long k0 = static_cast<long>(std::ceil(t0 / c.sample_time * (1 - 1e-12)));
+  if (k0 * c.sample_time > t0 && sim.status().kind == RunStatus::Kind::Running)
+    sim.advance(std::min(k0 * c.sample_time, t_end));
+  std::string last;  // the last output that took effect, for a run that fails after it
+  for (long k = k0;; ++k) {
+    const double tk = k * c.sample_time;
+    if (tk >= t_end * (1 - 1e-12) || sim.status().kind != RunStatus::Kind::Running) break;
+    ControlOutput u;
+    try {
+      u = controller(tk, sim.snapshot());
+      for (const auto& [name, tau] : u.torques)
+        if (!std::isfinite(tau)) throw std::invalid_argument(fmt::format("joint '{}': torque {} is not finite", name, tau));
+      for (const auto& [name, r] : u.references)
+        if (!std::isfinite(r.q) || !std::isfinite(r.v) || !std::isfinite(r.tau_ff))
+          throw std::invalid_argument("joint '" + name + "': the reference is not finite");
+      pending.push_back(std::move(u));
+      if (pending.size() > static_cast<size_t>(c.delay)) {
+        const ControlOutput& out = pending.front();
+        for (const auto& [name, tau] : out.torques) sim.set_torque(name, tau);
+        for (const auto& [name, r] : out.references) sim.set_reference(name, r.q, r.v, r.tau_ff);
+        last = fmt::format("t = {:.6g} s:", tk);
+        for (const auto& [name, tau] : out.torques) last += fmt::format(" {} = {:.6g}", name, tau);
+        for (const auto& [name, r] : out.references) last += fmt::format(" {} = {:.6g} (reference)", name, r.q);
+        for (size_t i = 0; i < recorded.size(); ++i) {
+          const std::string& name = md.joints[recorded[i]].name;
+          if (const auto it = out.torques.find(name); it != out.torques.end()) now[i] = it->second;
+          if (const auto it = out.references.find(name); it != out.references.end()) now[i] = it->second.q;
+        }
+        pending.pop_front();
+      }
+    } catch (const std::exception& e) {
+      return finish(RunStatus::failed(fmt::format("controller: {} at t = {:.6g} s", e.what(), tk)));
+    }
+    record.data.push_back(tk);
+    record.data.insert(record.data.end(), now.begin(), now.end());
+    ++record.rows;
+    const RunStatus st = sim.advance(std::min((k + 1) * c.sample_time, t_end));
+    // A run that fails under the controller's output says which output it was under.
+    if (st.kind == RunStatus::Kind::Failed && !last.empty())
+      return finish(RunStatus::failed(st.reason + " (under the controller's output of " + last + ")"));
+  }
+  return finish(std::nullopt);
+}
+
+}  // namespace rfem
