@@ -8,7 +8,7 @@
 #include "commands.hpp"
 #include "rfem/results/errors.hpp"
 #include "rfem/studies/recorders.hpp"
-#include "rfem/studies/simulation.hpp"
+#include "rfem/studies/run_file.hpp"
 
 namespace rfem::app {
 
@@ -28,15 +28,9 @@ int run_linearize(const Common& c, const LinearizeOptions& o) {
   }
   LinearModel lin;
   try {
-    lin = linearize(cs, rq);
+    lin = linearize_into_file(cs, rq, o.output, c.command_line);
   } catch (const std::invalid_argument& e) {  // another model's state
     throw CaseError("--state: " + o.state + ": " + e.what());
-  }
-  {
-    ResultsWriter file(o.output, describe(cs, c.command_line, "linearize",
-                                          static_cast<long>(lin.states.size() - lin.inputs.size()) / 6, rq.threads, c.n));
-    write_linear(file, lin);
-    file.close();
   }
   // The first-order model's eigenvalues: frequencies [Hz] and damping ratios of its lowest modes.
   const std::vector<std::pair<double, double>> modes = linear_modes(lin, 6);

@@ -3,8 +3,8 @@
 #include <fmt/ranges.h>
 
 #include "commands.hpp"
-#include "rfem/studies/modes_study.hpp"
-#include "rfem/studies/recorders.hpp"
+#include "rfem/results/errors.hpp"
+#include "rfem/studies/run_file.hpp"
 
 namespace rfem::app {
 
@@ -15,7 +15,12 @@ int run_modes(const Common& c, const ModesOptions& o) {
   rq.count = o.count;
   rq.rate = o.rate;
   rq.free = o.free;
-  const ModesStudy s = modes_study(cs, rq);
+  ModesStudy s;
+  try {
+    s = modes_into_file(cs, rq, o.output, c.command_line, max_threads(c));
+  } catch (const ResultsError& e) {  // (a path that cannot be written: the program's usage error)
+    throw CaseError(e.what());
+  }
   const Model& model = *s.model;
   const ModesResult& r = s.modes;
   const int nf = static_cast<int>(s.free.size());
@@ -55,12 +60,7 @@ int run_modes(const Common& c, const ModesOptions& o) {
                  fmt::format("{}{}", to_string(r.kind[i]), s.index_of_kind[i]), extra);
   }
   for (const auto& w : s.warnings) print_warning(w);
-  if (!o.output.empty()) {
-    ResultsWriter file = create_results(o.output, describe(cs, c.command_line, "modes", model.n(), max_threads(c)));
-    write_modes(file, s);
-    file.close();
-    if (!c.json) fmt::print("mode shapes in {}\n", o.output);
-  }
+  if (!o.output.empty() && !c.json) fmt::print("mode shapes in {}\n", o.output);
   if (!c.json && s.has_reference)
     fmt::print("reference: (T) Timoshenko cantilever (shear and rotary inertia), (rod) rod theory; the error is "
                "the discretisation's and falls as 1/n²\n");

@@ -98,9 +98,6 @@ Case read_checked_case(const Common& c);
 /// Refuses a run the machine's memory cannot hold (CaseError); before a run of kLargeRunRfes rfes
 /// or more prints its memory and the timed cost of a step (unless quiet).
 void check_run_cost(const Case& cs, std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs, const Common& c);
-/// A results file for the command's output: an unusable path (the case itself, a file that is
-/// not HDF5, a file another run writes, a directory that is not writable) is bad input (CaseError).
-ResultsWriter create_results(const std::string& path, const FileDescription& d);
 /// The largest thread team a run may use (--threads, else OpenMP's default).
 int max_threads(const Common& c);
 

@@ -36,14 +36,6 @@ void check_run_cost(const Case& cs, std::shared_ptr<const Model> model, const st
                model->n(), e.bytes / 1e6, e.residual_s * 1e3, e.newton_setup_s * 1e3, e.step_s());
 }
 
-ResultsWriter create_results(const std::string& path, const FileDescription& d) {
-  try {
-    return ResultsWriter(path, d);
-  } catch (const ResultsError& e) {
-    throw CaseError(e.what());
-  }
-}
-
 int max_threads(const Common& c) {
   Parallelism p;
   p.threads = c.threads;

@@ -17,6 +17,7 @@
 #include <memory>
 
 #include "arguments.hpp"
+#include "call_guard.hpp"
 #include "pickling.hpp"
 #include "rfem/cases/case_file.hpp"
 #include "rfem/results/xdmf.hpp"
@@ -56,42 +57,7 @@ py::array view(std::shared_ptr<Owner> owner, const double* data, long rows, long
 
 py::array vector_array(const Eigen::VectorXd& v) { return py::array_t<double>(v.size(), v.data()); }
 
-// Collects what Python must see once the GIL is back: the first exception raised in a callback
-// (a KeyboardInterrupt from Ctrl-C, or the user's own), after which the study is stopped.
-struct Pending {
-  py::object error = py::none();
-  StopToken stop;
-  py::object progress = py::none();
-  double last_poll = 0.0;
-
-  // Polls Python's signals and calls the user's callback; called with the GIL released.
-  void beat(const Progress* p) {
-    py::gil_scoped_acquire gil;
-    if (!error.is_none()) return;
-    if (PyErr_CheckSignals() != 0) {
-      error = fetch();
-      stop.request(PyErr_GivenExceptionMatches(error.ptr(), PyExc_KeyboardInterrupt) ? SIGINT : 0);
-      return;
-    }
-    if (p && !progress.is_none()) {
-      try {
-        py::dict d;
-        d["run"] = p->run;
-        d["t"] = p->t;
-        d["t_end"] = p->t_end;
-        d["steps"] = p->steps;
-        progress(d);
-      } catch (py::error_already_set& e) {
-        error = e.value();
-        stop.request(PyErr_GivenExceptionMatches(error.ptr(), PyExc_KeyboardInterrupt) ? SIGINT : 0);
-      }
-    }
-  }
-  static py::object fetch() {
-    py::error_already_set e;
-    return e.value();
-  }
-};
+using pyguard::CallGuard;  // (Ctrl-C and the script's progress while C++ runs: call_guard.hpp)
 
 // How a file was made from Python: the script's command line and the call.
 std::string python_made_by(const std::string& call) {
@@ -102,11 +68,6 @@ std::string python_made_by(const std::string& call) {
   } catch (...) {
   }
   return argv + (argv.empty() ? "" : " ") + "(Python " + call + ")";
-}
-
-FileDescription python_description(const Case& cs, const std::string& call, const std::string& procedure, long n, long threads,
-                                   long n_option = -1) {
-  return describe(cs, python_made_by(call), procedure, n, threads, n_option);
 }
 
 py::dict stats_dict(const IntegratorStats& s) {
@@ -161,7 +122,7 @@ std::vector<std::string> free_joints(py::handle v) {
 }
 
 // A run request from Python: progress and Ctrl-C through `pending`, warnings collected.
-RunRequest python_request(const std::shared_ptr<Pending>& pending, py::handle progress, py::handle threads, py::handle keep_series,
+RunRequest python_request(const std::shared_ptr<CallGuard>& pending, py::handle progress, py::handle threads, py::handle keep_series,
                           py::handle checkpoint, std::vector<std::string>& warnings) {
   pending->progress = args::callback(progress, "progress");
   RunRequest rq;
@@ -360,7 +321,7 @@ PYBIND11_MODULE(_rfem, m) {
     const Case& cs = *cs_arg;
     const int n = args::rfes(n_arg);
     const std::string output = args::path(output_arg, "output", true);
-    auto pending = std::make_shared<Pending>();
+    auto pending = std::make_shared<CallGuard>();
     std::vector<std::string> warnings;
     RunRequest rq = python_request(pending, progress, threads, keep_series, checkpoint, warnings);
     rq.n = n;
@@ -375,8 +336,7 @@ PYBIND11_MODULE(_rfem, m) {
     pyorigin::remember_runs(results, cs, n);
     py::list out;
     for (auto& r : results) out.append(std::make_shared<RunResult>(std::move(r)));
-    py::object error = pending->error;
-    pending->progress = py::none();
+    py::object error = pending->take();
     return py::make_tuple(out, error, warnings);
   }, py::arg("case"), py::arg("n"), py::arg("output"), py::arg("runs"), py::arg("threads"), py::arg("keep_series"),
      py::arg("progress"), py::arg("checkpoint"));
@@ -385,7 +345,7 @@ PYBIND11_MODULE(_rfem, m) {
 
   m.def("_resume", [](py::handle path_arg, py::handle threads, py::handle keep_series, py::handle progress, py::handle checkpoint) {
     const std::string path = args::path(path_arg, "resume");
-    auto pending = std::make_shared<Pending>();
+    auto pending = std::make_shared<CallGuard>();
     std::vector<std::string> warnings;
     RunRequest rq = python_request(pending, progress, threads, keep_series, checkpoint, warnings);
     std::vector<RunResult> results;
@@ -401,8 +361,7 @@ PYBIND11_MODULE(_rfem, m) {
     pyorigin::remember_runs(results, plan_kept->cs, plan_kept->n);
     py::list out;
     for (auto& r : results) out.append(std::make_shared<RunResult>(std::move(r)));
-    py::object error = pending->error;
-    pending->progress = py::none();
+    py::object error = pending->take();
     return py::make_tuple(out, error, warnings, done);
   }, py::arg("path"), py::arg("threads"), py::arg("keep_series"), py::arg("progress"), py::arg("checkpoint"));
 
@@ -508,13 +467,9 @@ PYBIND11_MODULE(_rfem, m) {
     rq.free = free_joints(free);
     rq.rate = joint_rate(rate, joint);
     const std::string output = args::path(output_arg, "output", true);
+    const std::string made_by = output.empty() ? "" : python_made_by("rfem.modes");
     py::gil_scoped_release release;
-    auto s = std::make_shared<ModesStudy>(modes_study(cs, rq));
-    if (!output.empty()) {
-      ResultsWriter file(output, python_description(cs, "rfem.modes", "modes", s->model->n(), 1));
-      write_modes(file, *s);
-      file.close();
-    }
+    auto s = std::make_shared<ModesStudy>(modes_into_file(cs, rq, output, made_by, 1));
     pyorigin::remember(s->model, cs, rq.n);  // (C++ only: no GIL needed)
     return s;
   }, py::arg("case"), py::arg("n"), py::arg("count"), py::arg("free"), py::arg("rate"), py::arg("joint"), py::arg("output"));
@@ -526,7 +481,7 @@ PYBIND11_MODULE(_rfem, m) {
     const Case& cs = *cs_arg;
     const std::vector<std::string> quantities = args::texts(quantity_args, "quantities");
     const std::string output = args::path(output_arg, "output", true);
-    auto pending = std::make_shared<Pending>();
+    auto pending = std::make_shared<CallGuard>();
     pending->progress = args::callback(progress, "progress");
     RefineRequest rq;
     rq.ns = args::rfes_list(ns, "ns");
@@ -569,8 +524,7 @@ PYBIND11_MODULE(_rfem, m) {
     }
     out["tables"] = tables;
     out["warnings"] = warnings;
-    py::object error = pending->error;
-    pending->progress = py::none();
+    py::object error = pending->take();
     return py::make_tuple(out, error);
   }, py::arg("case"), py::arg("ns"), py::arg("quantities"), py::arg("output"), py::arg("integration_check"),
      py::arg("rate"), py::arg("joint"), py::arg("threads"), py::arg("progress"), py::arg("modes"));

@@ -11,12 +11,14 @@
 #include <memory>
 
 #include "arguments.hpp"
+#include "call_guard.hpp"
 #include "pickling.hpp"
 #include <pybind11/eigen.h>
 
 #include "rfem/results/writer.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/recorders.hpp"
+#include "rfem/studies/run_file.hpp"
 #include "rfem/studies/simulation.hpp"
 
 namespace py = pybind11;
@@ -25,22 +27,7 @@ namespace args = rfem::pyargs;
 
 namespace {
 
-// Ctrl-C while C++ integrates: the heartbeat and the controller poll Python's signals; the first
-// exception is kept (raised when the call returns) and stops the run within a step.
-struct Poll {
-  StopToken stop;
-  py::object error = py::none();  // a KeyboardInterrupt (or the exception a heartbeat raised)
-  py::object bad = py::none();    // what a controller returned that it should not have: TypeError, ValueError
-  void check() {
-    py::gil_scoped_acquire gil;
-    if (!error.is_none()) return;
-    if (PyErr_CheckSignals() != 0) {
-      py::error_already_set e;
-      error = e.value();
-      stop.request(SIGINT);
-    }
-  }
-};
+using Poll = pyguard::CallGuard;
 
 py::array_t<double> array(const VecX& v) { return py::array_t<double>(v.size(), v.data()); }
 
@@ -82,7 +69,8 @@ SimulationOptions options(py::handle n, py::handle threads, py::handle output, p
   o.driven_by = made_by;  // (a script's run: its inputs are the script's)
   if (state) o.state = std::make_shared<const SimulationState>(std::move(*state));
   o.stop = poll->stop;
-  o.heartbeat = [poll](double, long) { poll->check(); };
+  o.progress = [poll](const Progress&) { poll->beat(nullptr); };
+  o.progress_interval = 0.1;
   return o;
 }
 
@@ -177,6 +165,7 @@ void bind_simulation(py::module_& m) {
     Use(const Use&) = delete;
     Use& operator=(const Use&) = delete;
     Simulation* operator->() const { return p.sim.get(); }
+    Simulation& operator*() const { return *p.sim; }
   };
   py::class_<PySimulation>(m, "_Simulation")
       .def(py::init([](py::handle case_arg, py::handle n, py::handle threads, py::handle output, py::handle keep_series,
@@ -217,8 +206,7 @@ void bind_simulation(py::module_& m) {
           py::gil_scoped_release release;
           s = use->advance(t);
         }
-        py::object error = p.poll->error;
-        p.poll->error = py::none();
+        py::object error = p.poll->take();
         return py::make_tuple(s.to_string(), error);
       })
       .def("snapshot", [](PySimulation& p) {
@@ -230,7 +218,7 @@ void bind_simulation(py::module_& m) {
         const bool eq = args::flag(equilibrium, "equilibrium"), d = args::flag(dense, "dense");
         const Use use(p, "linearize");
         py::gil_scoped_release release;
-        return std::make_shared<LinearModel>(use->linearize(eq, d));
+        return std::make_shared<LinearModel>(linearize(*use, eq, d));
       })
       .def("finish", [](PySimulation& p) {
         std::shared_ptr<RunResult> r;
@@ -321,13 +309,7 @@ void bind_simulation(py::module_& m) {
     }
     const std::string output = args::path(output_arg, "output", true);
     py::gil_scoped_release release;
-    auto lin = std::make_shared<LinearModel>(linearize(cs, rq));
-    if (!output.empty()) {
-      ResultsWriter file(output, describe(cs, made_by, "linearize", static_cast<long>(lin->states.size() - lin->inputs.size()) / 6, rq.threads, rq.n));
-      write_linear(file, *lin);
-      file.close();
-    }
-    return lin;
+    return std::make_shared<LinearModel>(linearize_into_file(cs, rq, output, made_by));
   }, py::arg("case"), py::arg("n"), py::arg("state"), py::arg("threads"), py::arg("equilibrium"), py::arg("output"), py::arg("made_by"), py::arg("dense"));
 
   m.def("_run_controlled", [](py::handle case_arg, py::handle n, py::handle threads, py::handle output, py::handle keep_series,
@@ -345,19 +327,13 @@ void bind_simulation(py::module_& m) {
     const Controller f = [&](double t, const Snapshot& y) {
       py::gil_scoped_acquire gil;
       ControlOutput u;
-      if (PyErr_CheckSignals() != 0) {
-        py::error_already_set e;
-        poll->error = e.value();
-        poll->stop.request(SIGINT);
-        return u;
-      }
+      if (!poll->signals()) return u;
       py::object r;
       try {
         r = controller(t, snapshot_dict(y, *model));
       } catch (py::error_already_set& e) {
         if (e.matches(PyExc_KeyboardInterrupt)) {
-          poll->error = e.value();
-          poll->stop.request(SIGINT);
+          poll->keep(e);
           return u;
         }
         // The run ends `failed: controller: TYPE: message`, the Python exception not raised again.
@@ -391,6 +367,12 @@ void bind_simulation(py::module_& m) {
     ControlOptions c;
     c.sample_time = args::real(sample_time, "sample_time", "a finite time [s]");
     c.delay = static_cast<int>(args::integer(delay, "delay", 0, INT_MAX, "a number of samples, 0 or more"));
+    // A value the C++ loop refused (not finite) is a ValueError too (called with the GIL released).
+    c.on_error = [poll](const ControllerError& e) {
+      if (e.kind() != ControllerError::Kind::NotFinite) return;
+      py::gil_scoped_acquire gil;
+      if (poll->bad.is_none()) poll->bad = py::reinterpret_borrow<py::object>(PyExc_ValueError)(e.what());
+    };
     std::shared_ptr<RunResult> result;
     {
       py::gil_scoped_release release;
@@ -399,10 +381,6 @@ void bind_simulation(py::module_& m) {
       result = std::make_shared<RunResult>(run_controlled(cs, std::move(o), f, c));
       pyorigin::remember(result->model, cs, n_rfes);
     }
-    // A non-finite value the C++ loop refused is a ValueError too.
-    if (poll->bad.is_none() && result->status.kind == RunStatus::Kind::Failed &&
-        result->status.reason.find("is not finite") != std::string::npos && result->status.reason.rfind("controller: ", 0) == 0)
-      poll->bad = py::reinterpret_borrow<py::object>(PyExc_ValueError)(result->status.reason);
     return py::make_tuple(result, poll->error, poll->bad);
   }, py::arg("case"), py::arg("n"), py::arg("threads"), py::arg("output"), py::arg("keep_series"), py::arg("state"),
      py::arg("made_by"), py::arg("controller"), py::arg("sample_time"), py::arg("delay"));

@@ -16,6 +16,13 @@
 
 namespace rfem {
 
+VecX initial_joint_values(const Model& model, const std::vector<JointInput>& inputs) {
+  RFEM_CHECK_ARGUMENT_SIZE(inputs.size(), model.m(), "inputs");
+  VecX qb(model.m());
+  for (int j = 0; j < model.m(); ++j) qb[j] = inputs[j].prescribed() ? inputs[j].motion->at(0.0).q : inputs[j].q0;
+  return qb;
+}
+
 namespace {
 const Model& checked(const std::shared_ptr<const Model>& m) {
   if (!m) throw std::invalid_argument("EquationsOfMotion: no model");
@@ -53,9 +60,7 @@ EquationsOfMotion::EquationsOfMotion(std::shared_ptr<const Model> model_ptr, std
     }
   nu_ = static_cast<int>(unknown_.size());
   ubase_col_ = base_col_;
-  VecX qb(model.m());  // the reduced links' modes: at the joints' initial values
-  for (int j = 0; j < model.m(); ++j) qb[j] = inputs[j].prescribed() ? inputs[j].motion->at(0.0).q : inputs[j].q0;
-  reduction_ = Reduction::of(model, qb, parallel);
+  reduction_ = Reduction::of(model, initial_joint_values(model, inputs), parallel);
   if (reduction_) {
     nu_ = reduction_->rfe() + (nu_ - n6);
     for (int& c : ubase_col_)

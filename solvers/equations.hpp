@@ -40,6 +40,10 @@ struct Power {
   double input = 0.0;        ///< τ · q̇_b of every joint [W]
 };
 
+/// The joints' values at t = 0 (a motion law's, else the input's q0): where a reduced link's modes
+/// are taken (solvers/reduction.hpp).
+VecX initial_joint_values(const Model& model, const std::vector<JointInput>& inputs);
+
 class EquationsOfMotion {
  public:
   /// One input per joint; throws std::invalid_argument otherwise (or for a null model, a null law).

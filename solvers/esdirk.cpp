@@ -538,14 +538,4 @@ IntegratorState EsdirkStepper::Impl::state_scalars() const {
   return x;
 }
 
-RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& o, SampleEmitter& emit) {
-  EsdirkStepper stepper(eq, o);
-  RunOutcome out;
-  out.status = stepper.start(emit);
-  if (out.status.kind == RunStatus::Kind::Running) out.status = stepper.advance(o.t_end, emit);
-  out.stats = stepper.stats();
-  out.t_reached = stepper.t_reached();
-  return out;
-}
-
 }  // namespace rfem

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "rfem/core/check.hpp"
+#include "rfem/solvers/esdirk_stepper.hpp"
 
 namespace rfem {
 
@@ -18,41 +19,65 @@ double now_s() {
 // Rigid manipulator with every joint prescribed: nothing to integrate, inverse dynamics at each
 // output; the input work by Simpson's rule on each output interval (error O(Δt⁵) per interval,
 // below round-off of the balance for smooth laws; the trapezoidal rule left 1e-5 J of drift).
-RunOutcome inverse_dynamics_only(EquationsOfMotion& eq, const IntegratorOptions& opts, SampleEmitter& emit) {
-  RunOutcome out;
-  const long n_out = output_count(opts);
-  auto power = [&](double t) {
-    const OutputSample s = eq.sample(t, nullptr, nullptr, nullptr, 0.0, 0.0);
-    return s.tau.dot(eq.model().joint_coords(s.v));
-  };
-  double W = 0.0, last_t = 0.0, last_P = 0.0;
-  try {
-    for (long k = 0; k <= n_out; ++k) {
-      const double t = output_time(opts, k);
-      if (eq.stop_requested()) {
-        out.status = RunStatus::interrupted(eq.stop().signal());
-        return out;
-      }
-      const double Pm = k > 0 ? power(0.5 * (t + last_t)) : 0.0;
-      OutputSample s = eq.sample(t, nullptr, nullptr, nullptr, 0.0, 0.0);
-      const double P = s.tau.dot(eq.model().joint_coords(s.v));
-      W += (last_P + 4.0 * Pm + P) * (t - last_t) / 6.0;
-      s.input_work = W;
-      last_t = t;
-      last_P = P;
-      if (!emit(s) || !emit.beat(t, 0)) {
-        out.status = emit.failure();
-        return out;
-      }
-      out.t_reached = t;
-    }
-  } catch (const std::exception& e) {
-    out.status = RunStatus::failed(e.what());
-    return out;
+class InverseDynamics final : public Stepper {
+ public:
+  InverseDynamics(EquationsOfMotion& eq, const IntegratorOptions& opts) : eq_(eq), o_(opts), n_out_(output_count(opts)) {}
+  RunStatus start(SampleEmitter& emit) override {
+    RFEM_CHECK_ARGUMENT(!started_, "the stepper has started already");
+    started_ = true;
+    if (emit.resume()) throw std::invalid_argument("a run without unknowns (inverse dynamics) does not resume: run it again");
+    return output(emit);
   }
-  out.status = RunStatus::completed();
-  return out;
-}
+  RunStatus advance(double until, SampleEmitter& emit) override {
+    RFEM_CHECK_ARGUMENT(started_, "start() first");
+    RFEM_CHECK_ARGUMENT(until >= t_ && until <= o_.t_end, "until must lie in [t, t_end]");
+    while (k_ <= n_out_ && output_time(o_, k_) <= until)
+      if (RunStatus s = output(emit); s.kind != RunStatus::Kind::Running) return s;
+    t_ = until;
+    return t_ >= o_.t_end ? RunStatus::completed() : RunStatus{};
+  }
+  void inputs_changed() override {}  // (the joints follow their laws: nothing is held)
+  double time() const override { return t_; }
+  double t_reached() const override { return t_reached_; }
+  const IntegratorStats& stats() const override { return st_; }
+  IntegratorState state() const override {
+    throw std::logic_error("a run without unknowns (inverse dynamics) has no state to go on from: run it again");
+  }
+  bool has_state() const override { return false; }
+
+ private:
+  double power(double t) const {
+    const OutputSample s = eq_.sample(t, nullptr, nullptr, nullptr, 0.0, 0.0);
+    return s.tau.dot(eq_.model().joint_coords(s.v));
+  }
+  // Output k_ (then the next one's index).
+  RunStatus output(SampleEmitter& emit) {
+    const double t = output_time(o_, k_);
+    if (eq_.stop_requested()) return RunStatus::interrupted(eq_.stop().signal());
+    try {
+      const double Pm = k_ > 0 ? power(0.5 * (t + last_t_)) : 0.0;
+      OutputSample s = eq_.sample(t, nullptr, nullptr, nullptr, 0.0, 0.0);
+      const double P = s.tau.dot(eq_.model().joint_coords(s.v));
+      W_ += (last_P_ + 4.0 * Pm + P) * (t - last_t_) / 6.0;
+      s.input_work = W_;
+      last_t_ = t;
+      last_P_ = P;
+      if (!emit(s) || !emit.beat(t, 0)) return emit.failure();
+    } catch (const std::exception& e) {
+      return RunStatus::failed(e.what());
+    }
+    t_ = t_reached_ = t;
+    ++k_;
+    return RunStatus{};
+  }
+  EquationsOfMotion& eq_;
+  const IntegratorOptions o_;
+  const long n_out_;
+  long k_ = 0;
+  double W_ = 0.0, last_t_ = 0.0, last_P_ = 0.0, t_ = 0.0, t_reached_ = 0.0;
+  IntegratorStats st_;
+  bool started_ = false;
+};
 
 }  // namespace
 
@@ -161,22 +186,35 @@ void check_options(const IntegratorOptions& o) {
   if (o.kind == IntegratorKind::Esdirk) check_esdirk_table(o.esdirk_table);
 }
 
+std::unique_ptr<Stepper> make_bdf_stepper(EquationsOfMotion& eq, const IntegratorOptions& opts);  // (solvers/bdf.cpp)
+
+std::unique_ptr<Stepper> make_stepper(EquationsOfMotion& eq, const IntegratorOptions& opts) {
+  check_options(opts);
+  if (eq.unknowns() == 0) return std::make_unique<InverseDynamics>(eq, opts);
+  if (opts.kind == IntegratorKind::Bdf) return make_bdf_stepper(eq, opts);
+  return std::make_unique<EsdirkStepper>(eq, opts);
+}
+
 RunOutcome integrate(std::shared_ptr<const Model> model, std::vector<JointInput> inputs, const IntegratorOptions& opts,
                      const SampleSink& sink, const RunControl& control) {
   check_options(opts);
   EquationsOfMotion eq(std::move(model), std::move(inputs), opts.forces, control.stop, opts.linear_solver, opts.parallel,
                        opts.kind == IntegratorKind::Bdf);  // IDA's solve needs K on its own
   SampleEmitter emit(sink, control);
+  RunOutcome out;
+  std::unique_ptr<Stepper> stepper;
   try {
-    if (control.resume && eq.unknowns() == 0)
-      throw std::invalid_argument("a run without unknowns (inverse dynamics) does not resume: run it again");
-    if (eq.unknowns() == 0) return inverse_dynamics_only(eq, opts, emit);
-    return opts.kind == IntegratorKind::Bdf ? integrate_bdf(eq, opts, emit) : integrate_esdirk(eq, opts, emit);
-  } catch (const std::exception& e) {  // (the integrators report their own failures; this is what is left)
-    RunOutcome out;
+    stepper = make_stepper(eq, opts);
+    out.status = stepper->start(emit);
+    if (out.status.kind == RunStatus::Kind::Running) out.status = stepper->advance(opts.t_end, emit);
+  } catch (const std::exception& e) {  // (the steppers report their own failures; this is what is left)
     out.status = RunStatus::failed(e.what());
-    return out;
   }
+  if (stepper) {
+    out.stats = stepper->stats();
+    out.t_reached = stepper->t_reached();
+  }
+  return out;
 }
 
 RunOutcome integrate(const Model& model, const std::vector<JointInput>& inputs, const IntegratorOptions& opts,

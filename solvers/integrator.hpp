@@ -152,12 +152,6 @@ inline constexpr int kLargeRunRfes = 10000;
 RunEstimate estimate_run(std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs,
                          const IntegratorOptions& opts, bool time);
 
-/// The integrators behind integrate() (the equations hold the unknowns' layout and Newton system).
-/// `emit` delivers a sample to the sink and returns false once the sink has failed (the run then
-/// ends failed; control's heartbeat is called by `beat`).
-class SampleEmitter;
-RunOutcome integrate_esdirk(EquationsOfMotion& eq, const IntegratorOptions& opts, SampleEmitter& emit);
-RunOutcome integrate_bdf(EquationsOfMotion& eq, const IntegratorOptions& opts, SampleEmitter& emit);
 
 /// The reason of a failure at the start of a run, with its time if it does not say one.
 std::string at_start(const std::string& why);

@@ -63,11 +63,14 @@ RunResult run_controlled(const Case& cs, SimulationOptions opts, const Controlle
     ControlOutput u;
     try {
       u = controller(tk, sim.snapshot());
+      const auto refused = [&](const std::string& why) {
+        return ControllerError(ControllerError::Kind::NotFinite, tk, fmt::format("controller: {} at t = {:.6g} s", why, tk));
+      };
       for (const auto& [name, tau] : u.torques)
-        if (!std::isfinite(tau)) throw std::invalid_argument(fmt::format("joint '{}': torque {} is not finite", name, tau));
+        if (!std::isfinite(tau)) throw refused(fmt::format("joint '{}': torque {} is not finite", name, tau));
       for (const auto& [name, r] : u.references)
         if (!std::isfinite(r.q) || !std::isfinite(r.v) || !std::isfinite(r.tau_ff))
-          throw std::invalid_argument("joint '" + name + "': the reference is not finite");
+          throw refused("joint '" + name + "': the reference is not finite");
       pending.push_back(std::move(u));
       if (pending.size() > static_cast<size_t>(c.delay)) {
         const ControlOutput& out = pending.front();
@@ -84,7 +87,17 @@ RunResult run_controlled(const Case& cs, SimulationOptions opts, const Controlle
         pending.pop_front();
       }
     } catch (const std::exception& e) {
-      return finish(RunStatus::failed(fmt::format("controller: {} at t = {:.6g} s", e.what(), tk)));
+      const auto* typed = dynamic_cast<const ControllerError*>(&e);
+      const ControllerError err = typed ? *typed
+                                        : ControllerError(ControllerError::Kind::Threw, tk,
+                                                          fmt::format("controller: {} at t = {:.6g} s", e.what(), tk));
+      if (c.on_error) {
+        try {
+          c.on_error(err);
+        } catch (...) {  // (the caller's channel: the run's record says why in any case)
+        }
+      }
+      return finish(RunStatus::failed(err.what()));
     }
     record.data.push_back(tk);
     record.data.insert(record.data.end(), now.begin(), now.end());

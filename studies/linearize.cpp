@@ -17,6 +17,8 @@
 
 #include "rfem/results/reader.hpp"
 #include "rfem/results/writer.hpp"
+#include "rfem/core/positions.hpp"
+#include "rfem/studies/sensors.hpp"
 #include "rfem/studies/simulation.hpp"
 
 namespace rfem {
@@ -386,6 +388,64 @@ void write_linear(ResultsWriter& file, const LinearModel& lin) {
                                                           " states: E x' = [0 I; -K -D] x + [0; B] u, E = [I 0; 0 M]");
 }
 
+LinearModel linearize(Simulation& sim, bool equilibrium, bool dense) {
+  const IntegratorState x = sim.integrator_state();
+  const Model& md = sim.model();
+  EquationsOfMotion& eq = sim.equations();
+  SensorBank* sensors = sim.sensors();
+  const int N = eq.unknowns();
+  LinearModel lin;
+  lin.t = x.t;
+  lin.equilibrium = equilibrium;
+  const std::vector<std::string> names = sim.coordinate_names();
+  lin.states = eq.unknown_names(names);
+  std::vector<int> free_rows;
+  for (int j = 0; j < md.m(); ++j)
+    if (eq.base_col()[j] >= 0) {
+      lin.inputs.push_back(md.joints[j].name);
+      free_rows.push_back(eq.base_col()[j]);
+    }
+  for (const MountedLink& L : md.links)
+    for (const char* c : {"tip_u1", "tip_u2", "tip_theta"}) {
+      lin.outputs.push_back(L.name + "/" + c);
+      lin.output_units.push_back(c == std::string("tip_theta") ? "rad" : "m");
+    }
+  for (const Joint& J : md.joints) {
+    const bool turns = J.type == JointType::Revolute;
+    for (const char* c : {"q", "v", "tau"}) lin.outputs.push_back(J.name + "/" + c);
+    lin.output_units.insert(lin.output_units.end(), {turns ? "rad" : "m", turns ? "rad/s" : "m/s", turns ? "N m" : "N"});
+  }
+  if (sensors) {
+    const auto c = sensors->columns(), u = sensors->units();
+    lin.outputs.insert(lin.outputs.end(), c.begin(), c.end());
+    lin.output_units.insert(lin.output_units.end(), u.begin(), u.end());
+  }
+  // The outputs at full coordinates and joint torques.
+  std::vector<double> out;
+  const OutputEvaluation outputs = [&](const VecX& q, const VecX& v, const VecX& a, const VecX& tau, VecX& y) {
+    out.clear();
+    for (size_t l = 0; l < md.links.size(); ++l) {
+      const Vec3 d = tip_deflection(md, static_cast<int>(l), q);
+      out.insert(out.end(), {d[0], d[1], d[2]});
+    }
+    for (int j = 0; j < md.m(); ++j) out.insert(out.end(), {q[md.joint_index(j)], v[md.joint_index(j)], tau[j]});
+    if (sensors) sensors->read(q, v, a, tau, out, -1);  // (exact: no noise, no quantisation)
+    y = Eigen::Map<const VecX>(out.data(), static_cast<Eigen::Index>(out.size()));
+  };
+  // The equations the integrators solve, over the (reduced) unknowns.
+  const LinearEvaluation f = [&](const VecX& qu, const VecX& vu, const VecX& au, VecX& r, VecX& y) {
+    r.resize(N);
+    eq.residual(x.t, qu.data(), vu.data(), au.data(), r.data());
+    outputs(eq.full_coordinates(x.t, qu.data(), 0), eq.full_coordinates(x.t, vu.data(), 1),
+            eq.full_coordinates(x.t, au.data(), 2), eq.torques(x.t), y);
+  };
+  const VecX a0 = equilibrium ? VecX::Zero(N) : x.a;
+  const int rfe_rows = N - static_cast<int>(free_rows.size());
+  if (dense) linearize_about(f, x.q, x.v, a0, free_rows, rfe_rows, lin);
+  else linearize_sparse(eq, x.t, f, outputs, x.q, x.v, a0, free_rows, rfe_rows, lin);
+  return lin;
+}
+
 LinearModel linearize(const Case& cs, const LinearizeRequest& rq) {
   Case c = cs;
   c.sim.options.kind = IntegratorKind::Esdirk;  // (the equations are the integrators' same; only a stepped one starts here)
@@ -396,7 +456,7 @@ LinearModel linearize(const Case& cs, const LinearizeRequest& rq) {
   o.state = rq.state;
   Simulation sim(c, std::move(o));
   if (sim.status().kind != RunStatus::Kind::Running) throw std::runtime_error("cannot linearise: " + sim.status().to_string());
-  LinearModel lin = sim.linearize(rq.equilibrium, rq.dense);
+  LinearModel lin = linearize(sim, rq.equilibrium, rq.dense);
   sim.finish(RunStatus::interrupted(0));
   return lin;
 }

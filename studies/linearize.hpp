@@ -20,6 +20,7 @@
 #include "rfem/solvers/equations.hpp"
 #include "rfem/solvers/reduction.hpp"
 #include "rfem/studies/linear_jacobian.hpp"
+#include "rfem/studies/simulation.hpp"
 
 namespace rfem {
 
@@ -99,5 +100,27 @@ std::vector<std::pair<double, double>> linear_modes(const LinearModel& lin, int 
 /// with attributes rows and matrix_columns; Cq, Cv, Ca and, up to kFileDenseStates states, A, Bs, C,
 /// Ds as tables with their row and column names; the operating point, attributes t and equilibrium).
 void write_linear(ResultsWriter& file, const LinearModel& lin);
+
+/// The linear model of a simulation about its state now, the laws in force included: at rest
+/// (`equilibrium`: q̈ = 0, the free joints' inputs u0 those that hold it) or on the motion (q̈ the
+/// state's own). Sparse from O(1) evaluations of the equations whatever n (checked against their
+/// directional differences; std::runtime_error if they disagree), or `dense`: column by column (9
+/// evaluations per state: the reference).
+LinearModel linearize(Simulation& sim, bool equilibrium = true, bool dense = false);
+
+/// What rfem.linearize / `rfem linearize` asks for.
+struct LinearizeRequest {
+  int n = 0;        ///< rfes in all links (0: the case's own)
+  int threads = 1;  ///< the kernels' team
+  /// About this state (its time, the same model only); null: the case's initial state (its static
+  /// equilibrium, simulation.initial = "static") at t = 0.
+  std::shared_ptr<const SimulationState> state;
+  bool equilibrium = true;  ///< q̈ = 0 (at rest) or the state's own accelerations
+  bool dense = false;       ///< column by column (the reference) instead of the sparse method
+};
+/// The case's linear model. CaseError for a case that cannot run (check_runnable, integrator "bdf":
+/// linearised with the ESDIRK equations — the same equations), std::invalid_argument for another
+/// model's state.
+LinearModel linearize(const Case& cs, const LinearizeRequest& rq);
 
 }  // namespace rfem

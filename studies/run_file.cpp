@@ -1,6 +1,7 @@
 #include "rfem/studies/run_file.hpp"
 
 #include "rfem/results/errors.hpp"
+#include "rfem/results/writer.hpp"
 #include "rfem/studies/common.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/recorders.hpp"
@@ -11,17 +12,10 @@ namespace rfem {
 FileRuns run_from_state(const Case& cs, const RunRequest& rq, const std::string& output, const std::string& made_by) {
   check_runnable(cs);
   SimulationOptions o;
-  o.n = rq.n;
-  o.threads = rq.threads;
+  static_cast<RunOptions&>(o) = rq;
   o.output = output;
   o.made_by = made_by;
   o.driven_by = "";  // (the case's own laws: see plan_resume for why it still does not resume)
-  o.keep_series = rq.keep_series;
-  o.observers = rq.observers;
-  o.warn = rq.warn;
-  o.stop = rq.stop;
-  if (rq.progress)
-    o.heartbeat = [&rq, &cs](double t, long steps) { rq.progress({"run", t, cs.sim.options.t_end, steps}); };
   try {
     o.state = std::make_shared<const SimulationState>(load_state(cs.sim.state));
   } catch (const ResultsError& e) {
@@ -76,6 +70,28 @@ FileRuns run_into_file(const Case& cs, RunRequest rq, const std::string& output,
   // ParaView's view of every run that stored its poses (also of a failed run: what it computed).
   out.views = write_views(cs, *out.model, output, rq.warn);
   return out;
+}
+
+ModesStudy modes_into_file(const Case& cs, const ModesRequest& rq, const std::string& output, const std::string& made_by,
+                           long threads) {
+  ModesStudy s = modes_study(cs, rq);
+  if (!output.empty()) {
+    ResultsWriter file(output, describe(cs, made_by, "modes", s.model->n(), threads));
+    write_modes(file, s);
+    file.close();
+  }
+  return s;
+}
+
+LinearModel linearize_into_file(const Case& cs, const LinearizeRequest& rq, const std::string& output, const std::string& made_by) {
+  LinearModel lin = linearize(cs, rq);
+  if (!output.empty()) {
+    ResultsWriter file(output, describe(cs, made_by, "linearize", static_cast<long>(lin.states.size() - lin.inputs.size()) / 6,
+                                        rq.threads, rq.n));
+    write_linear(file, lin);
+    file.close();
+  }
+  return lin;
 }
 
 }  // namespace rfem

@@ -1,13 +1,17 @@
 #pragma once
 // The one path from a case to its results file: `rfem run`, Python's rfem.run and a sweep's points
 // all run a case into a file through run_into_file (a resumed run goes through resume_case,
-// studies/resume.hpp, into the file it continues).
+// studies/resume.hpp, into the file it continues); `rfem modes` and rfem.modes through
+// modes_into_file, `rfem linearize` and rfem.linearize through linearize_into_file.
 #include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "rfem/studies/linearize.hpp"
+#include "rfem/studies/modes_study.hpp"
 #include "rfem/studies/refine.hpp"
+#include "rfem/studies/simulation.hpp"
 #include "rfem/studies/runs.hpp"
 
 namespace rfem {
@@ -40,5 +44,14 @@ FileRuns run_into_file(const Case& cs, RunRequest rq, const std::string& output,
 /// then the `refine` group with the tables, and the file closed. The rows of a study that stops
 /// are kept.
 RefineResult refine_into_file(const Case& cs, RefineRequest rq, const std::string& output, const std::string& made_by);
+
+/// The case's modes (modes_study), written into a new results file at `output` (group `modes`,
+/// write_modes) unless it is "". `threads` is the team kept in the file's description.
+ModesStudy modes_into_file(const Case& cs, const ModesRequest& rq, const std::string& output, const std::string& made_by,
+                           long threads);
+
+/// The case's linear model (linearize), written into a new results file at `output` (group
+/// `linear`, write_linear) unless it is ""; std::invalid_argument for a state of another model.
+LinearModel linearize_into_file(const Case& cs, const LinearizeRequest& rq, const std::string& output, const std::string& made_by);
 
 }  // namespace rfem

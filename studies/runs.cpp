@@ -11,6 +11,7 @@
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/run_file.hpp"
 #include "rfem/studies/sensors.hpp"
+#include "rfem/studies/simulation.hpp"
 #include "rfem/studies/validity.hpp"
 
 namespace rfem {
@@ -52,7 +53,7 @@ constexpr const char* kSensorsKey = "sensor streams";
 }  // namespace
 
 RunBook::RunBook(std::string name, std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs, const Case& cs,
-                 const RunRequest& rq, const IntegratorOptions& o, const Checkpoint* checkpoint, const RunState* resumed)
+                 const RunOptions& rq, const IntegratorOptions& o, const Checkpoint* checkpoint, const RunState* resumed)
     : rq_(rq), o_(o), model_(std::move(model)), validity_(std::make_unique<ValidityMonitor>(*model_)),
       t0_(std::chrono::steady_clock::now()) {
   RunResult& s = s_;
@@ -221,29 +222,16 @@ RunResult RunBook::end(RunOutcome r) {
 
 namespace {
 
+// One run of the procedure: a Simulation advanced to t_end (resumed from its checkpoint, if any).
 RunResult run_one(const std::string& name, std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs,
                   const Case& cs, const RunRequest& rq) {
-  IntegratorOptions o = cs.sim.options;
-  o.parallel.threads = rq.threads;
+  SimulationOptions o;
+  static_cast<RunOptions&>(o) = rq;
+  o.driven_by = "";  // (the case's own laws)
   const auto from = rq.resume.find(name);
-  const Checkpoint* checkpoint = from == rq.resume.end() ? nullptr : &from->second;
-  RunState resumed;
-  if (checkpoint) resumed = RunState::unpack(checkpoint->state, -1);
-  RunBook book(name, model, inputs, cs, rq, o, checkpoint, &resumed);
-  RunControl control;
-  control.stop = rq.stop;
-  control.resume = checkpoint ? &resumed.integrator : nullptr;
-  control.checkpoint_interval = rq.checkpoint_interval;
-  control.heartbeat_interval = rq.progress_interval;
-  if (rq.progress) control.heartbeat = [&](double t, long steps) { rq.progress({name, t, o.t_end, steps}); };
-  control.checkpoint = [&](const IntegratorState& st) { book.checkpoint(st); };
-  RunOutcome r;
-  try {
-    r = integrate(model, inputs, o, [&](const OutputSample& x) { book.sample(x); }, control);
-  } catch (const std::exception& e) {  // (bad options or inputs): the run's record says why
-    r.status = RunStatus::failed(e.what());
-  }
-  return book.end(r);
+  Simulation sim(cs, name, std::move(model), inputs, std::move(o), from == rq.resume.end() ? nullptr : &from->second);
+  sim.advance(sim.t_end());
+  return sim.finish();
 }
 
 }  // namespace

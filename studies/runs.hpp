@@ -121,23 +121,34 @@ struct Progress {
 /// the state (3 numbers per unknown) costs well under 1 % of it (bench/checkpoint_bench.py).
 inline constexpr double kCheckpointInterval = 5.0;
 
-struct RunRequest {
+/// How a run goes, one meaning for every way of running (rfem run, a study's runs, a simulation a
+/// caller steps, Python): the discretisation, the thread team, what is kept and who hears of it.
+struct RunOptions {
   int n = 0;                  ///< rfes in all links (0: the case's own discretisation)
-  int threads = 0;            ///< the kernels' team (0: each run times one thread against all)
-  std::vector<RunName> runs;  ///< which of the procedure's runs (empty: all; the paper's force run
-                              ///< needs no other)
-  std::string prefix;         ///< put before every run's name ("n12/")
+  /// The kernels' team (0: each run times one thread against the largest team and keeps the
+  /// faster, solvers/thread_governor.hpp).
+  int threads = 0;
   bool keep_series = true;    ///< keep every series in memory (RunResult::series)
-  StopToken stop;             ///< request() ends the current run within a step, and the study
+  /// request() ends the current run within a step (interrupted), and a study's later runs.
+  StopToken stop;
   /// Called on the integrating thread at most every progress_interval seconds, and once at the end
-  /// of every run that got past t = 0 (where it ended), however short.
+  /// of every run that got past t = 0 (where it ended), however short. A callback that throws fails
+  /// the run with its message.
   std::function<void(const Progress&)> progress;
   double progress_interval = 0.2;
   std::vector<RunObserver*> observers;  ///< the caller keeps them alive for the call
   Warnings warn;
   /// Wall time between a run's checkpoints [s] (0: none): written by the observers' checkpoint()
-  /// (a results file's run group), resumed from with `resume`.
+  /// (a results file's run group), resumed from with RunRequest::resume. A run whose inputs come
+  /// from its caller (SimulationOptions::driven_by) keeps none: it cannot go on without the caller.
   double checkpoint_interval = kCheckpointInterval;
+};
+
+/// A case's procedure (one run, or the paper's three) under the same options.
+struct RunRequest : RunOptions {
+  std::vector<RunName> runs;  ///< which of the procedure's runs (empty: all; the paper's force run
+                              ///< needs no other)
+  std::string prefix;         ///< put before every run's name ("n12/")
   /// Continue a study (studies/resume.hpp): runs (by full name) that completed before and are not
   /// run again, and the checkpoints the others resume from.
   std::vector<std::string> done;
@@ -150,14 +161,14 @@ class SensorBank;
 
 /// The bookkeeping of one run as its outputs arrive — the observers, the series kept in memory,
 /// peaks, the energy balance's drift, the validity warnings, checkpoints of all that, the final
-/// progress report: what run_case does around its integrator, shared with a simulation that a
-/// caller steps (studies/simulation.hpp). The request (observers, callbacks) outlives the book.
+/// progress report: what a Simulation (studies/simulation.hpp) does around its stepper. The
+/// options (observers, callbacks) outlive the book.
 class RunBook {
  public:
   /// Tells the observers that the run begins; resuming (`checkpoint` and its unpacked `resumed`),
   /// restores the run's summary and the observers' state (std::invalid_argument for another model's).
   RunBook(std::string name, std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs, const Case& cs,
-          const RunRequest& rq, const IntegratorOptions& o, const Checkpoint* checkpoint = nullptr,
+          const RunOptions& rq, const IntegratorOptions& o, const Checkpoint* checkpoint = nullptr,
           const RunState* resumed = nullptr);
   ~RunBook();
   RunBook(const RunBook&) = delete;
@@ -180,7 +191,7 @@ class RunBook {
 
  private:
   double wall() const;
-  const RunRequest& rq_;
+  const RunOptions& rq_;
   IntegratorOptions o_;
   std::shared_ptr<const Model> model_;
   RunResult s_;

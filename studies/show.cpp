@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <functional>
 
+#include "rfem/solvers/equations.hpp"
 #include "rfem/solvers/modes.hpp"
+#include "rfem/solvers/reduction.hpp"
+#include "rfem/studies/inputs.hpp"
 
 namespace rfem {
 
@@ -51,8 +54,9 @@ ModelSummary show_model(const Case& cs, int n) {
   s.m = M.m();
   s.dof = M.dof();
   s.unknowns = M.flexible_dofs();
-  for (const MountedLink& L : M.links)  // a reduced link: its axial coordinates and its modes (solvers/reduction.hpp)
-    if (L.d.modes > 0) s.unknowns -= kModalAxes * L.n() - L.d.modes - L.d.derivatives * (L.d.derivatives + 1) / 2;
+  // A reduced link's unknowns are its axial coordinates, its modes and their derivatives: the
+  // reduction says how many (its modes taken where the equations take them).
+  if (const auto red = Reduction::of(M, initial_joint_values(M, joint_inputs(cs)))) s.unknowns = red->rfe();
   for (const InputSpec& in : cs.inputs) s.unknowns += in.prescribed() ? 0 : 1;
   // Children of every entity (a joint j is 2j, a link l is 2l + 1; the ground is −1).
   auto key = [](bool joint, int i) { return joint ? 2 * i : 2 * i + 1; };

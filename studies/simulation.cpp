@@ -9,7 +9,7 @@
 #include "rfem/core/positions.hpp"
 #include "rfem/results/errors.hpp"
 #include "rfem/results/writer.hpp"
-#include "rfem/solvers/esdirk_stepper.hpp"
+#include "rfem/studies/checkpoints.hpp"
 #include "rfem/studies/common.hpp"
 #include "rfem/studies/inputs.hpp"
 #include "rfem/studies/recorders.hpp"
@@ -152,7 +152,7 @@ SimulationState load_state(const std::string& path) {
 
 struct Simulation::Impl {
   Case cs;
-  SimulationOptions opts;
+  SimulationOptions opts;  // (observers: the results file's recorder first, then the caller's)
   IntegratorOptions o;
   std::shared_ptr<const Model> model;
   std::vector<JointInput> inputs;
@@ -160,14 +160,14 @@ struct Simulation::Impl {
   std::string signature;
   std::unique_ptr<ResultsWriter> file;
   std::unique_ptr<Hdf5Recorder> recorder;
-  RunRequest rq;
   std::unique_ptr<RunBook> book;
   std::unique_ptr<SensorBank> sensors;  // the snapshots' (the book records its own)
   std::unique_ptr<EquationsOfMotion> eq;
-  std::unique_ptr<EsdirkStepper> stepper;  // (after eq: it refers to it)
+  std::unique_ptr<Stepper> stepper;  // (after eq: it refers to it)
   SampleSink sink;
   RunControl control;
   IntegratorState resume;
+  RunState resumed;                     // a procedure's run from its checkpoint
   std::unique_ptr<SampleEmitter> emit;  // (after sink and control: it refers to them)
   RunStatus status;
   bool changed = false;  // a held value changed since the last step
@@ -180,6 +180,9 @@ struct Simulation::Impl {
     std::string description;
   };
   std::vector<PendingTable> tables;
+
+  void init(const Case& c, const std::string& name, const Checkpoint* checkpoint);
+  void start_from_state(const SimulationState& from);
 
   int joint(const std::string& name) const {
     for (int j = 0; j < model->m(); ++j)
@@ -216,20 +219,43 @@ struct Simulation::Impl {
   void require_running(const char* what) const {
     if (result) throw std::logic_error(std::string(what) + ": the simulation has finished (" + result->status.to_string() + ")");
   }
+  // The stepper's state (a run without unknowns has none to read).
+  IntegratorState now(const char* what) const {
+    if (!stepper || !stepper->has_state())
+      throw std::logic_error(std::string(what) + ": the run has no state (every joint prescribed, no flexible link, or it "
+                                                 "failed at its start)");
+    return stepper->state();
+  }
 };
 
 Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   check_runnable(cs);
-  if (cs.sim.options.kind != IntegratorKind::Esdirk)
-    throw CaseError(cs.path + ": simulation.integrator: a simulation that is stepped integrates with \"esdirk\" "
-                              "(IDA's BDF history cannot be handed over)");
-  m.cs = cs;
   m.opts = std::move(opts);
-  m.o = cs.sim.options;
-  m.o.parallel.threads = m.opts.threads;
   m.model = model_of(cs, m.opts.n);
   m.inputs = rfem::joint_inputs(cs, m.opts.warn);
+  m.init(cs, "run", nullptr);
+}
+
+Simulation::Simulation(const Case& cs, std::string name, std::shared_ptr<const Model> model, std::vector<JointInput> inputs,
+                       SimulationOptions opts, const Checkpoint* checkpoint)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  RFEM_CHECK_ARGUMENT(model != nullptr, "no model");
+  RFEM_CHECK_ARGUMENT_SIZE(inputs.size(), model->m(), "inputs");
+  check_runnable(cs);
+  m.opts = std::move(opts);
+  m.model = std::move(model);
+  m.inputs = std::move(inputs);
+  m.init(cs, name, checkpoint);
+}
+
+void Simulation::Impl::init(const Case& c, const std::string& name, const Checkpoint* checkpoint) {
+  Impl& m = *this;
+  m.cs = c;
+  const Case& cs = m.cs;
+  m.o = cs.sim.options;
+  m.o.parallel.threads = m.opts.threads;
   m.signature = model_signature(*m.model, m.inputs);
   m.held.resize(m.inputs.size());
   for (size_t j = 0; j < m.inputs.size(); ++j)
@@ -238,6 +264,8 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
       m.inputs[j].torque = m.held[j];
     }
   const SimulationState* from = m.opts.state.get();
+  RFEM_CHECK_ARGUMENT(!(from && checkpoint), "a run starts from a state or resumes from a checkpoint, not both");
+  const bool callers = !m.opts.driven_by.empty();  // a run whose inputs come from its caller
   if (from) {
     if (from->model != m.signature)
       throw std::invalid_argument("the state is of another model: it has " + from->model + "; this simulation " + m.signature);
@@ -258,6 +286,10 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
     m.resume.next_output = std::min(k, output_count(m.o) + 1);
     m.control.resume = &m.resume;
   }
+  if (checkpoint) {
+    m.resumed = RunState::unpack(checkpoint->state, -1);
+    m.control.resume = &m.resumed.integrator;
+  }
   if (!m.opts.output.empty()) {
     Parallelism p;
     p.threads = m.opts.threads;
@@ -265,18 +297,20 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
     d.driven_by = m.opts.driven_by;
     m.file = std::make_unique<ResultsWriter>(m.opts.output, d);  // (ResultsError for a path it cannot create)
     m.recorder = std::make_unique<Hdf5Recorder>(*m.file);
-    m.rq.observers.push_back(m.recorder.get());
+    m.opts.observers.insert(m.opts.observers.begin(), m.recorder.get());
   }
-  m.rq.observers.insert(m.rq.observers.end(), m.opts.observers.begin(), m.opts.observers.end());
-  m.rq.n = m.opts.n;
-  m.rq.threads = m.opts.threads;
-  m.rq.keep_series = m.opts.keep_series;
-  m.rq.warn = m.opts.warn;
-  m.rq.stop = m.opts.stop;
-  m.rq.checkpoint_interval = 0.0;  // (`rfem run --resume` would go on without the caller's hand)
-  m.book = std::make_unique<RunBook>("run", m.model, m.inputs, cs, m.rq, m.o);
+  // Checkpoints only where `rfem run --resume` can go on: a case's own run from t = 0.
+  if (callers || from) m.opts.checkpoint_interval = 0.0;
+  m.book = std::make_unique<RunBook>(name, m.model, m.inputs, cs, m.opts, m.o, checkpoint, checkpoint ? &m.resumed : nullptr);
   if (!cs.sensors.empty()) m.sensors = std::make_unique<SensorBank>(cs, *m.model);
-  m.eq = std::make_unique<EquationsOfMotion>(m.model, m.inputs, m.o.forces, m.rq.stop, m.o.linear_solver, m.o.parallel);
+  try {
+    m.eq = std::make_unique<EquationsOfMotion>(m.model, m.inputs, m.o.forces, m.opts.stop, m.o.linear_solver, m.o.parallel,
+                                               m.o.kind == IntegratorKind::Bdf);  // (IDA's solve needs K on its own)
+  } catch (const std::exception& e) {
+    if (callers || from) throw;
+    m.status = RunStatus::failed(e.what());  // (a case's run: its record says why)
+    return;
+  }
   if (from) {
     m.apply_drives(from->drives);
     if (!from->laws.empty()) restore_law_memory(m.inputs, from->laws);  // (version 1: the laws start afresh)
@@ -289,16 +323,21 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
       m.sensors->restore(std::vector<double>(from->sensors.begin() + static_cast<long>(half), from->sensors.end()));
     }
   }  // (after the equations took the case laws' gains for Newton)
-  if (m.eq->unknowns() == 0)
+  if (m.eq->unknowns() == 0 && (callers || from))
     throw CaseError(cs.path + ": joints: every joint follows a prescribed motion and there is no flexible link: nothing to step "
                               "(rfem run computes its torques)");
-  m.stepper = std::make_unique<EsdirkStepper>(*m.eq, m.o);
   m.sink = [&m](const OutputSample& x) { m.book->sample(x); };
-  m.control.stop = m.rq.stop;
-  m.control.heartbeat = m.opts.heartbeat;
-  m.control.heartbeat_interval = m.opts.heartbeat_interval;
+  m.control.stop = m.opts.stop;
+  if (m.opts.progress) {
+    const std::string run = name;
+    m.control.heartbeat = [&m, run](double t, long steps) { m.opts.progress({run, t, m.o.t_end, steps}); };
+  }
+  m.control.heartbeat_interval = m.opts.progress_interval;
+  m.control.checkpoint_interval = m.opts.checkpoint_interval;
+  m.control.checkpoint = [&m](const IntegratorState& st) { m.book->checkpoint(st); };
   m.emit = std::make_unique<SampleEmitter>(m.sink, m.control);
   try {
+    m.stepper = make_stepper(*m.eq, m.o);
     m.status = m.stepper->start(*m.emit);
     if (from && m.status.kind == RunStatus::Kind::Running) {  // the state's own row
       const IntegratorState& x = m.resume;
@@ -311,10 +350,11 @@ Simulation::Simulation(const Case& cs, SimulationOptions opts) : impl_(std::make
         m.book->restore_sensor_streams(std::vector<double>(from->sensors.begin(),
                                                            from->sensors.begin() + static_cast<long>(from->sensors.size() / 2)));
     }
-  } catch (const std::invalid_argument&) {
-    throw;  // a state that does not fit
+  } catch (const std::invalid_argument& e) {
+    if (callers || from) throw;  // a state that does not fit, options a caller gave
+    m.status = RunStatus::failed(e.what());  // (a case's run: a checkpoint that does not fit it)
   } catch (const std::exception& e) {
-    m.status = RunStatus::failed(at_start(e.what()));
+    m.status = RunStatus::failed(callers || from ? at_start(e.what()) : e.what());
   }
 }
 
@@ -330,19 +370,19 @@ Simulation::Simulation(Simulation&&) noexcept = default;
 
 const Model& Simulation::model() const { return *impl_->model; }
 std::shared_ptr<const Model> Simulation::shared_model() const { return impl_->model; }
-double Simulation::time() const { return impl_->stepper->time(); }
+double Simulation::time() const { return impl_->stepper ? impl_->stepper->time() : 0.0; }
 double Simulation::t_end() const { return impl_->o.t_end; }
 
 
 VecX Simulation::q() const {
   const Impl& m = *impl_;
-  const IntegratorState x = m.stepper->state();
+  const IntegratorState x = m.now("q");
   return m.eq->full_coordinates(x.t, x.q.data(), 0);
 }
 
 VecX Simulation::v() const {
   const Impl& m = *impl_;
-  const IntegratorState x = m.stepper->state();
+  const IntegratorState x = m.now("v");
   return m.eq->full_coordinates(x.t, x.v.data(), 1);
 }
 
@@ -420,7 +460,7 @@ Snapshot Simulation::snapshot() {
   Impl& m = *impl_;
   m.require_running("snapshot");
   m.bring_inputs_up_to_date();
-  const IntegratorState x = m.stepper->state();
+  const IntegratorState x = m.now("snapshot");
   // The equations at the state give the joints' torques (applied, or required by a prescribed
   // motion); a snapshot needs no energies or momentum (an output sample's extra passes).
   m.scratch.resize(m.eq->unknowns());
@@ -453,7 +493,7 @@ SimulationState Simulation::state() const {
   const Impl& m = *impl_;
   SimulationState s;
   s.model = m.signature;
-  s.integrator = m.stepper->state();
+  s.integrator = m.now("state");
   s.drives.assign(static_cast<size_t>(kDriveValues * m.model->m()), 0.0);
   for (int j = 0; j < m.model->m(); ++j)
     if (const HeldLaw* h = m.held[j].get()) {
@@ -473,65 +513,19 @@ SimulationState Simulation::state() const {
   return s;
 }
 
-LinearModel Simulation::linearize(bool equilibrium, bool dense) {
+IntegratorState Simulation::integrator_state() {
   Impl& m = *impl_;
-  m.require_running("linearize");
+  m.require_running("integrator_state");
   m.bring_inputs_up_to_date();
-  const IntegratorState x = m.stepper->state();
-  const Model& md = *m.model;
-  EquationsOfMotion& eq = *m.eq;
-  const int N = eq.unknowns();
-  LinearModel lin;
-  lin.t = x.t;
-  lin.equilibrium = equilibrium;
-  const std::vector<std::string> names = coordinate_names();
-  lin.states = eq.unknown_names(names);
-  std::vector<int> free_rows;
-  for (int j = 0; j < md.m(); ++j)
-    if (eq.base_col()[j] >= 0) {
-      lin.inputs.push_back(md.joints[j].name);
-      free_rows.push_back(eq.base_col()[j]);
-    }
-  for (const MountedLink& L : md.links)
-    for (const char* c : {"tip_u1", "tip_u2", "tip_theta"}) {
-      lin.outputs.push_back(L.name + "/" + c);
-      lin.output_units.push_back(c == std::string("tip_theta") ? "rad" : "m");
-    }
-  for (const Joint& J : md.joints) {
-    const bool turns = J.type == JointType::Revolute;
-    for (const char* c : {"q", "v", "tau"}) lin.outputs.push_back(J.name + "/" + c);
-    lin.output_units.insert(lin.output_units.end(), {turns ? "rad" : "m", turns ? "rad/s" : "m/s", turns ? "N m" : "N"});
-  }
-  if (m.sensors) {
-    const auto c = m.sensors->columns(), u = m.sensors->units();
-    lin.outputs.insert(lin.outputs.end(), c.begin(), c.end());
-    lin.output_units.insert(lin.output_units.end(), u.begin(), u.end());
-  }
-  // The outputs at full coordinates and joint torques.
-  std::vector<double> out;
-  const OutputEvaluation outputs = [&](const VecX& q, const VecX& v, const VecX& a, const VecX& tau, VecX& y) {
-    out.clear();
-    for (size_t l = 0; l < md.links.size(); ++l) {
-      const Vec3 d = tip_deflection(md, static_cast<int>(l), q);
-      out.insert(out.end(), {d[0], d[1], d[2]});
-    }
-    for (int j = 0; j < md.m(); ++j) out.insert(out.end(), {q[md.joint_index(j)], v[md.joint_index(j)], tau[j]});
-    if (m.sensors) m.sensors->read(q, v, a, tau, out, -1);  // (exact: no noise, no quantisation)
-    y = Eigen::Map<const VecX>(out.data(), static_cast<Eigen::Index>(out.size()));
-  };
-  // The equations the integrators solve, over the (reduced) unknowns.
-  const LinearEvaluation f = [&](const VecX& qu, const VecX& vu, const VecX& au, VecX& r, VecX& y) {
-    r.resize(N);
-    eq.residual(x.t, qu.data(), vu.data(), au.data(), r.data());
-    outputs(eq.full_coordinates(x.t, qu.data(), 0), eq.full_coordinates(x.t, vu.data(), 1),
-            eq.full_coordinates(x.t, au.data(), 2), eq.torques(x.t), y);
-  };
-  const VecX a0 = equilibrium ? VecX::Zero(N) : x.a;
-  const int rfe_rows = N - static_cast<int>(free_rows.size());
-  if (dense) linearize_about(f, x.q, x.v, a0, free_rows, rfe_rows, lin);
-  else linearize_sparse(eq, x.t, f, outputs, x.q, x.v, a0, free_rows, rfe_rows, lin);
-  return lin;
+  return m.now("integrator_state");
 }
+
+EquationsOfMotion& Simulation::equations() {
+  RFEM_CHECK_ARGUMENT(impl_->eq != nullptr, "the simulation failed before its equations were built");
+  return *impl_->eq;
+}
+
+SensorBank* Simulation::sensors() { return impl_->sensors.get(); }
 
 RunResult Simulation::finish(std::optional<RunStatus> status) {
   Impl& m = *impl_;

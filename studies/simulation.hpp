@@ -1,23 +1,27 @@
 #pragma once
-// A simulation a caller steps (MuJoCo's mj_step loop, Drake's AdvanceTo): built from a case, it
-// keeps the integrator's state between calls. advance(t) integrates to t, the last step ending
-// exactly there; between calls the caller reads the state and sensors, holds joint torques or PD
-// references (zero-order hold), takes the state out and starts other simulations from it. The run
-// is recorded like `rfem run`'s (studies/runs.hpp: observers, series, peaks, energy balance) and,
-// with an output path, into a results file of the same layout, group "run". ESDIRK only (BDF's IDA
-// keeps a history that cannot be handed over). A controller at a sample rate (run_controlled) is a
-// loop over advance().
+// The simulation: the only thing that advances a run (MuJoCo's mj_step loop, Drake's AdvanceTo).
+// Built from a case, it keeps the stepper's state between calls. advance(t) integrates to t, the
+// last step ending exactly there; between calls the caller reads the state and sensors, holds joint
+// torques or PD references (zero-order hold), takes the state out and starts other simulations from
+// it. `rfem run` is a Simulation per run of the procedure advanced to t_end (studies/runs.hpp); the
+// run is recorded through observers (series, peaks, energy balance, checkpoints) and, with an output
+// path, into a results file of the same layout, group "run". With BDF a state restarts IDA (its
+// history is not handed over: the same solution within the tolerances, not bit for bit). A
+// controller at a sample rate (run_controlled) is a loop over advance().
 #include <functional>
 #include <map>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "rfem/studies/linearize.hpp"
 #include "rfem/studies/runs.hpp"
+#include "rfem/solvers/stepper.hpp"
 
 namespace rfem {
+
+class SensorBank;
 
 /// Everything a simulation needs to go on from where it was: the integrator's state (time,
 /// coordinates, rates, accelerations, step size, energy integrals) and the drives' held values,
@@ -45,24 +49,16 @@ std::string model_signature(const Model& model, const std::vector<JointInput>& i
 void save_state(const SimulationState& state, const std::string& path);
 SimulationState load_state(const std::string& path);
 
-struct SimulationOptions {
-  int n = 0;                 ///< rfes in all links (0: the case's own)
-  int threads = 0;           ///< the kernels' team (0: OpenMP's default)
-  std::string output;        ///< results file ("": none)
+/// A simulation's options: a run's (studies/runs.hpp), and where it writes and starts from.
+struct SimulationOptions : RunOptions {
+  SimulationOptions() { keep_series = false; }  // (a stepped run keeps its series only if asked)
+  std::string output;        ///< results file ("": none; observers may still record)
   std::string made_by = "rfem::Simulation";  ///< kept in the file (command_line)
   /// Who steps it, kept in the file (driven_by): `rfem run --resume` refuses a run whose inputs came
-  /// from its caller. "" for a case's own run (from a saved state: run_from_state).
+  /// from its caller, and such a run keeps no checkpoints. "" for a case's own run.
   std::string driven_by = "rfem::Simulation";
-  bool keep_series = false;  ///< keep every series in memory (finish()'s RunResult::series)
   /// Start from this state instead of the case's initial state (its time; the results start there).
   std::shared_ptr<const SimulationState> state;
-  std::vector<RunObserver*> observers;  ///< the caller keeps them alive while the simulation lives
-  Warnings warn;
-  StopToken stop;            ///< request() ends the current advance() within a step (Interrupted)
-  /// Called from advance()'s step loop at most every heartbeat_interval seconds of wall time (to
-  /// poll something of the caller's: Python's Ctrl-C); if it throws, the run fails with its message.
-  std::function<void(double t, long steps)> heartbeat;
-  double heartbeat_interval = 0.1;  ///< [s]
 };
 
 /// What a lab measures at the simulation's time: joint encoders and torques (applied, or required
@@ -76,12 +72,22 @@ struct Snapshot {
   std::vector<std::pair<std::string, std::vector<double>>> sensors;
 };
 
+/// The one engine that advances a run: `rfem run`'s procedure (run_case: a Simulation per run,
+/// advanced to t_end), a caller's stepping and a controller's loop alike. It owns the run's model,
+/// equations and stepper (solvers/stepper.hpp: ESDIRK, IDA's BDF, or inverse dynamics without
+/// unknowns) and its book (RunBook); files are written by observers (studies/recorders.hpp).
 class Simulation {
  public:
-  /// CaseError for a case that cannot run (studies/runs.hpp: check_runnable) or BDF;
+  /// The case's run on its own model (opts.n rfes) and inputs, stepped by the caller. CaseError for
+  /// a case that cannot run (studies/runs.hpp: check_runnable) or has nothing to step;
   /// std::invalid_argument for a state of another model; the results file, if any, is created here
   /// (ResultsError for a path it cannot create).
   Simulation(const Case& cs, SimulationOptions opts);
+  /// Run `name` of the case's procedure on a given model and inputs (one per joint), from t = 0 or
+  /// resumed from `checkpoint` (studies/resume.hpp; std::invalid_argument for another model's). A
+  /// start that fails (bad options, a checkpoint that does not fit the run) is the run's status.
+  Simulation(const Case& cs, std::string name, std::shared_ptr<const Model> model, std::vector<JointInput> inputs,
+             SimulationOptions opts, const Checkpoint* checkpoint = nullptr);
   ~Simulation();  ///< finishes the run if the caller did not (status "interrupted (stopped)")
   Simulation(Simulation&&) noexcept;
   Simulation& operator=(Simulation&&) = delete;
@@ -118,12 +124,13 @@ class Simulation {
   Snapshot snapshot();
   /// The state now, to save or to start other simulations from.
   SimulationState state() const;
-  /// The linear model about the state now (studies/linearize.hpp), the laws in force included: at
-  /// rest (`equilibrium`: q̈ = 0, the free joints' inputs u0 those that hold it) or on the motion
-  /// (q̈ the state's own). Sparse from O(1) evaluations of the equations whatever n (checked
-  /// against their directional differences; std::runtime_error if they disagree), or `dense`:
-  /// column by column (9 evaluations per state: the reference).
-  LinearModel linearize(bool equilibrium = true, bool dense = false);
+  /// The stepper's state now, the inputs held since the last step in force (what a linear model is
+  /// taken about: studies/linearize.hpp). std::logic_error for a run without a state.
+  IntegratorState integrator_state();
+  /// The equations it integrates (the caller evaluates them; it must not step them).
+  EquationsOfMotion& equations();
+  /// The case's sensors as a snapshot reads them (null without [[sensors]]).
+  SensorBank* sensors();
   /// Ends the run with `status` (default: how advance() left it — completed if at t_end, else
   /// interrupted (stopped)), closes the results file and returns the run's record (again on later
   /// calls). Afterwards only the getters work (the rest throws std::logic_error).
@@ -155,9 +162,26 @@ struct ControlOutput {
 /// f(t, y): the controller, called at t = k·sample_time with the snapshot y there.
 using Controller = std::function<ControlOutput(double t, const Snapshot& y)>;
 
+/// Why run_controlled ended a run at a sample: the controller threw, or returned a value the loop
+/// refuses (not finite). what() is the run's failure reason ("controller: … at t = … s").
+class ControllerError : public std::runtime_error {
+ public:
+  enum class Kind { Threw, NotFinite };
+  ControllerError(Kind kind, double t, const std::string& reason) : std::runtime_error(reason), kind_(kind), t_(t) {}
+  Kind kind() const { return kind_; }
+  double t() const { return t_; }  ///< the sample's time [s]
+
+ private:
+  Kind kind_;
+  double t_;
+};
+
 struct ControlOptions {
   double sample_time = 0.0;  ///< [s], > 0 and ≤ the run's t_end
   int delay = 0;             ///< whole samples between a controller's call and its output taking effect
+  /// Told of a controller's failure before the run ends with it (a caller's own error channel: a
+  /// Python ValueError for a value that is not finite). What it throws is ignored.
+  std::function<void(const ControllerError&)> on_error;
 };
 
 /// Runs the case with a digital controller in the loop: at every sample time t_k = k·sample_time
@@ -169,19 +193,5 @@ struct ControlOptions {
 /// `failed: controller: …` with every earlier row kept.
 RunResult run_controlled(const Case& cs, SimulationOptions opts, const Controller& controller, const ControlOptions& control);
 
-/// What rfem.linearize / `rfem linearize` asks for.
-struct LinearizeRequest {
-  int n = 0;        ///< rfes in all links (0: the case's own)
-  int threads = 1;  ///< the kernels' team
-  /// About this state (its time, the same model only); null: the case's initial state (its static
-  /// equilibrium, simulation.initial = "static") at t = 0.
-  std::shared_ptr<const SimulationState> state;
-  bool equilibrium = true;  ///< q̈ = 0 (at rest) or the state's own accelerations
-  bool dense = false;       ///< column by column (the reference) instead of the sparse method
-};
-/// The case's linear model. CaseError for a case that cannot run (check_runnable, integrator "bdf":
-/// linearised with the ESDIRK equations — the same equations), std::invalid_argument for another
-/// model's state.
-LinearModel linearize(const Case& cs, const LinearizeRequest& rq);
 
 }  // namespace rfem

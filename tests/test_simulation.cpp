@@ -11,7 +11,9 @@
 #include <fstream>
 #include <iterator>
 
+#include "rfem/core/positions.hpp"
 #include "rfem/results/reader.hpp"
+#include "rfem/studies/inputs.hpp"
 #include "rfem/studies/sensors.hpp"
 #include "rfem/studies/simulation.hpp"
 #include "tests/test_models.hpp"
@@ -512,7 +514,7 @@ TEST(Simulation, ADivergingLoopEndsDivergedWithItsRowsKept) {
     ControlOutput u;
     u.torques["hub"] = 1e5 * y.joint_v[0] + 1e3;
     return u;
-  }, ControlOptions{0.01, 0});
+  }, ControlOptions{0.01, 0, {}});
   ASSERT_EQ(r.status.kind, RunStatus::Kind::Failed) << r.status;
   EXPECT_EQ(r.status.reason.rfind("diverged at t = ", 0), 0u) << r.status;
   EXPECT_LT(r.t_reached, 1.0);
@@ -535,14 +537,84 @@ TEST(Simulation, AControllerStartsFromAStatesTime) {
     ControlOutput u;
     u.torques["hub"] = 200.0;
     return u;
-  }, ControlOptions{0.01, 0});
+  }, ControlOptions{0.01, 0, {}});
   ASSERT_TRUE(r.completed()) << r.status;
   ASSERT_FALSE(called.empty());
   EXPECT_NEAR(called.front(), 0.11, 1e-12);  // the first sample after the state's time
   EXPECT_NEAR(called.back(), 0.29, 1e-12);
   // Bad sample times and delays are refused before the run.
-  EXPECT_THROW(run_controlled(cs, one_thread(), [](double, const Snapshot&) { return ControlOutput{}; }, ControlOptions{1e-300, 0}),
+  EXPECT_THROW(run_controlled(cs, one_thread(), [](double, const Snapshot&) { return ControlOutput{}; }, ControlOptions{1e-300, 0, {}}),
                std::invalid_argument);
-  EXPECT_THROW(run_controlled(cs, one_thread(), [](double, const Snapshot&) { return ControlOutput{}; }, ControlOptions{0.01, 1000000}),
+  EXPECT_THROW(run_controlled(cs, one_thread(), [](double, const Snapshot&) { return ControlOutput{}; }, ControlOptions{0.01, 1000000, {}}),
                std::invalid_argument);
+}
+
+// IDA's BDF behind the same engine: stepped in 10 ms chunks (each one IDA's stop time) and started
+// again from a state taken mid-run (IDA restarts there), it agrees with one BDF run to the
+// integrator's accuracy (README "Performance": integration error below 1e-4 of the peaks; two such
+// solutions differ by at most twice that).
+TEST(Simulation, BdfIsSteppedAndStartsFromAStateWithinItsAccuracy) {
+  Case cs = hub(0.5);
+  cs.sim.options.kind = IntegratorKind::Bdf;
+  Simulation whole(cs, one_thread()), chunks(cs, one_thread());
+  ASSERT_EQ(whole.advance(0.5).kind, RunStatus::Kind::Completed);
+  for (int k = 1; k <= 50; ++k) {
+    if (k == 20) chunks.set_torque("hub", 220.0);  // (the case's own torque, held: IDA restarts from it)
+    ASSERT_EQ(chunks.advance(std::min(0.5, k * 1e-2)).kind, k < 50 ? RunStatus::Kind::Running : RunStatus::Kind::Completed);
+  }
+  Simulation first(cs, one_thread());
+  first.advance(0.25);
+  SimulationOptions o = one_thread();
+  o.state = std::make_shared<const SimulationState>(first.state());
+  Simulation second(cs, o);
+  ASSERT_EQ(second.advance(0.5).kind, RunStatus::Kind::Completed);
+  const RunResult a = whole.finish(), b = chunks.finish(), c = second.finish();
+  ASSERT_TRUE(a.completed() && b.completed() && c.completed()) << a.status << b.status << c.status;
+  const Table ua = series(a, "tip_deflection");
+  EXPECT_LT(max_difference(ua, series(a, "time"), series(b, "tip_deflection"), series(b, "time")), 2e-4 * max_abs(ua));
+  EXPECT_LT(max_difference(ua, series(a, "time"), series(c, "tip_deflection"), series(c, "time")), 2e-4 * max_abs(ua));
+  EXPECT_EQ(series(c, "time").data.front(), 0.25);
+}
+
+// A procedure's run is a Simulation advanced to t_end: the same bits as the integrator called
+// directly on the same model and inputs (one engine, not two).
+TEST(Simulation, AProcedureRunIsTheIntegratorsRunBitForBit) {
+  const Case cs = hub(0.3);
+  RunRequest rq;
+  rq.threads = 1;
+  const RunResult run = run_case(cs, rq).at(0);
+  IntegratorOptions o = cs.sim.options;
+  o.parallel.threads = 1;
+  std::vector<double> tips;
+  const RunOutcome direct = integrate(run.model, joint_inputs(cs), o, [&](const OutputSample& x) {
+    const Vec3 u = tip_deflection(*run.model, 0, x.q);
+    tips.insert(tips.end(), {u[0], u[1], u[2]});
+  });
+  ASSERT_TRUE(direct.completed() && run.completed());
+  EXPECT_EQ(direct.stats.steps, run.stats.steps);
+  EXPECT_EQ(tips, series(run, "tip_deflection").data);
+}
+
+// A controller's failure reaches its caller typed (ControllerError), not as text to match: a value
+// that is not finite is refused by the loop (NotFinite), an exception is the controller's (Threw);
+// either way the run ends failed with the same words at that sample.
+TEST(Simulation, AControllersFailureIsTyped) {
+  const Case cs = hub(0.2);
+  for (const bool throws : {false, true}) {
+    std::vector<ControllerError> seen;
+    ControlOptions c{0.01, 0, {}};
+    c.on_error = [&](const ControllerError& e) { seen.push_back(e); };
+    const RunResult r = run_controlled(cs, one_thread(), [throws](double t, const Snapshot&) {
+      ControlOutput u;
+      if (t > 0.045 && throws) throw std::runtime_error("sensor lost");
+      u.torques["hub"] = t > 0.045 ? NAN : 220.0;
+      return u;
+    }, c);
+    ASSERT_EQ(seen.size(), 1u);
+    EXPECT_EQ(seen[0].kind(), throws ? ControllerError::Kind::Threw : ControllerError::Kind::NotFinite);
+    EXPECT_DOUBLE_EQ(seen[0].t(), 0.05);
+    ASSERT_EQ(r.status.kind, RunStatus::Kind::Failed);
+    EXPECT_EQ(r.status.reason, seen[0].what());
+    EXPECT_DOUBLE_EQ(r.t_reached, 0.05);  // (every row up to that sample kept)
+  }
 }

@@ -166,14 +166,6 @@ class Runs(list):
         return "<rfem.Runs " + ", ".join(f"{r.name}: {r.status}" for r in self) + ">"
 
 
-def _raise(error, result):
-    if error is None:
-        return
-    if isinstance(error, KeyboardInterrupt):
-        raise RunInterrupted(result, "interrupted by Ctrl-C; the results so far are in .result") from error
-    raise error
-
-
 def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, progress=None, resume=None,
         checkpoint=_rfem.CHECKPOINT_INTERVAL, controller=None, sample_time=None, delay=0):
     """Runs the case's [simulation] by its procedure (single: "run"; paper: "rigid", "kinematic",
@@ -404,6 +396,6 @@ LinearModel.frequency_response = _frequency_response
 
 
 # A simulation a script steps and controllers in the loop (python/rfem/simulation.py).
-from .simulation import Simulation, SimulationState, load_state, run_controlled  # noqa: E402
+from .simulation import Simulation, SimulationState, load_state, run_controlled, _raise  # noqa: E402
 
 __all__ += ["Simulation", "SimulationState", "load_state", "run_controlled"]

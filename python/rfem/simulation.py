@@ -27,8 +27,12 @@ def _state(state):
     raise TypeError(f"state must be an rfem.SimulationState or a file, not {type(state).__name__}")
 
 
-def _raise_interrupt(error, result):
+def _raise(error, result):
+    """Raises what a C++ call kept (call_guard.hpp): Ctrl-C as RunInterrupted with the results so
+    far in .result, anything else as it was; nothing if it kept nothing."""
     from . import RunInterrupted  # (the package's; imported late: this module is part of it)
+    if error is None:
+        return
     if isinstance(error, KeyboardInterrupt):
         raise RunInterrupted(result, "interrupted by Ctrl-C; the results so far are in .result") from error
     raise error
@@ -79,7 +83,7 @@ class Simulation:
         status. Ctrl-C raises RunInterrupted (the rows so far are kept)."""
         status, error = self._sim.advance(t)
         if error is not None:
-            _raise_interrupt(error, self._sim.finish())
+            _raise(error, self._sim.finish())
         return status
 
     def set_torque(self, joint, tau):
@@ -136,7 +140,7 @@ def run_controlled(case, controller, sample_time, n=None, delay=0, output=None, 
     run, error, bad = _rfem._run_controlled(case, n, threads, output, keep_series, _state(state),
                                             "rfem.run_controlled (Python)", controller, sample_time, delay)
     if error is not None:
-        _raise_interrupt(error, run)
+        _raise(error, run)
     if bad is not None:
         bad.run = run
         raise bad
