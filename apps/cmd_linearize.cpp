@@ -6,9 +6,9 @@
 #include <cmath>
 
 #include "commands.hpp"
-#include "rfem/results/errors.hpp"
-#include "rfem/studies/recorders.hpp"
-#include "rfem/studies/run_file.hpp"
+#include "../results/errors.hpp"
+#include "../studies/recorders.hpp"
+#include "../studies/run_file.hpp"
 
 namespace rfem::app {
 

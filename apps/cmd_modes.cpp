@@ -3,8 +3,8 @@
 #include <fmt/ranges.h>
 
 #include "commands.hpp"
-#include "rfem/results/errors.hpp"
-#include "rfem/studies/run_file.hpp"
+#include "../results/errors.hpp"
+#include "../studies/run_file.hpp"
 
 namespace rfem::app {
 

@@ -8,10 +8,10 @@
 #include "commands.hpp"
 #include "progress.hpp"
 #include "signals.hpp"
-#include "rfem/studies/inputs.hpp"
-#include "rfem/studies/recorders.hpp"
-#include "rfem/studies/refine.hpp"
-#include "rfem/studies/run_file.hpp"
+#include "../studies/inputs.hpp"
+#include "../studies/recorders.hpp"
+#include "../studies/refine.hpp"
+#include "../studies/run_file.hpp"
 
 namespace rfem::app {
 

@@ -5,10 +5,10 @@
 #include "commands.hpp"
 #include "progress.hpp"
 #include "signals.hpp"
-#include "rfem/studies/inputs.hpp"
-#include "rfem/studies/recorders.hpp"
-#include "rfem/studies/resume.hpp"
-#include "rfem/studies/run_file.hpp"
+#include "../studies/inputs.hpp"
+#include "../studies/recorders.hpp"
+#include "../studies/resume.hpp"
+#include "../studies/run_file.hpp"
 
 namespace rfem::app {
 

@@ -2,7 +2,7 @@
 #include <fmt/core.h>
 
 #include "commands.hpp"
-#include "rfem/studies/show.hpp"
+#include "../studies/show.hpp"
 
 namespace rfem::app {
 

@@ -2,7 +2,7 @@
 #include <fmt/core.h>
 
 #include "commands.hpp"
-#include "rfem/studies/static_study.hpp"
+#include "../studies/static_study.hpp"
 
 namespace rfem::app {
 

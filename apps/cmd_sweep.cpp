@@ -8,8 +8,8 @@
 
 #include "commands.hpp"
 #include "signals.hpp"
-#include "rfem/results/errors.hpp"
-#include "rfem/studies/sweep.hpp"
+#include "../results/errors.hpp"
+#include "../studies/sweep.hpp"
 
 namespace rfem::app {
 

@@ -2,7 +2,7 @@
 #include <fmt/core.h>
 
 #include "commands.hpp"
-#include "rfem/results/xdmf.hpp"
+#include "../results/xdmf.hpp"
 
 namespace rfem::app {
 

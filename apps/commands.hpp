@@ -7,12 +7,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "rfem/cases/case_file.hpp"
-#include "rfem/results/writer.hpp"
-#include "rfem/solvers/inputs.hpp"
-#include "rfem/studies/common.hpp"
-#include "rfem/studies/runs.hpp"
-#include "rfem/studies/sweep.hpp"
+#include "../cases/case_file.hpp"
+#include "../results/writer.hpp"
+#include "../solvers/inputs.hpp"
+#include "../studies/common.hpp"
+#include "../studies/runs.hpp"
+#include "../studies/sweep.hpp"
 
 namespace rfem::app {
 

@@ -2,8 +2,8 @@
 #include <fmt/core.h>
 
 #include "commands.hpp"
-#include "rfem/assembly/workspace.hpp"
-#include "rfem/studies/estimate.hpp"
+#include "../assembly/workspace.hpp"
+#include "../studies/estimate.hpp"
 
 namespace rfem::app {
 

@@ -5,7 +5,7 @@
 #include <chrono>
 #include <string>
 
-#include "rfem/studies/runs.hpp"
+#include "../studies/runs.hpp"
 
 namespace rfem::app {
 

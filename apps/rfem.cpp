@@ -12,8 +12,8 @@
 #include <omp.h>
 
 #include "commands.hpp"
-#include "rfem/assembly/workspace.hpp"
-#include "rfem/results/errors.hpp"
+#include "../assembly/workspace.hpp"
+#include "../results/errors.hpp"
 #include "rfem/version.hpp"
 
 namespace {

@@ -5,7 +5,7 @@
 // process; the previous handlers come back when it dies.
 #include <signal.h>
 
-#include "rfem/solvers/run_status.hpp"
+#include "../solvers/run_status.hpp"
 
 namespace rfem::app {
 

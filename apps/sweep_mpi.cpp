@@ -16,9 +16,9 @@
 
 #include "commands.hpp"
 #include "signals.hpp"
-#include "rfem/assembly/workspace.hpp"
-#include "rfem/results/errors.hpp"
-#include "rfem/studies/sweep.hpp"
+#include "../assembly/workspace.hpp"
+#include "../results/errors.hpp"
+#include "../studies/sweep.hpp"
 
 #ifdef RFEM_HAVE_MPI
 #define OMPI_SKIP_MPICXX 1  // the C API only (OpenMPI's C++ bindings need their own library)

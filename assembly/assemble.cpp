@@ -1,13 +1,13 @@
-#include "rfem/assembly/assemble.hpp"
+#include "assemble.hpp"
 
 #include <omp.h>
 #include <sched.h>
 
 #include <algorithm>
 
-#include "rfem/assembly/rfe_kernels.hpp"
-#include "rfem/assembly/sde_kernels.hpp"
-#include "rfem/core/check.hpp"
+#include "rfe_kernels.hpp"
+#include "sde_kernels.hpp"
+#include "../core/check.hpp"
 
 namespace rfem {
 

@@ -6,9 +6,9 @@
 // results do not depend on the thread count. Rfes that carry a joint or a link are bodies of the
 // kinematic tree (core/model.hpp): the tree's pass after the loop gives their rows, and the few
 // sdes at their ends are assembled serially after the loop.
-#include "rfem/assembly/pattern.hpp"
-#include "rfem/assembly/workspace.hpp"
-#include "rfem/core/kinematics.hpp"
+#include "pattern.hpp"
+#include "workspace.hpp"
+#include "../core/kinematics.hpp"
 
 namespace rfem {
 

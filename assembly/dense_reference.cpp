@@ -1,10 +1,10 @@
-#include "rfem/assembly/dense_reference.hpp"
+#include "dense_reference.hpp"
 
-#include "rfem/core/check.hpp"
+#include "../core/check.hpp"
 
-#include "rfem/assembly/assemble.hpp"
-#include "rfem/assembly/sde_kernels.hpp"
-#include "rfem/core/rotation.hpp"
+#include "assemble.hpp"
+#include "sde_kernels.hpp"
+#include "../core/rotation.hpp"
 
 namespace rfem {
 

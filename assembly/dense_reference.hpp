@@ -3,7 +3,7 @@
 // coordinate (O(N²) work): a_ij = Σ_bodies tr(∂W/∂q_i H ∂W/∂q_jᵀ) [3.10]–[3.11], and the Hessians
 // of the elastic [3.12] and gravity [3.18] energies. The reference the sparse assembly is tested
 // against; not for production use.
-#include "rfem/core/model.hpp"
+#include "../core/model.hpp"
 
 namespace rfem {
 

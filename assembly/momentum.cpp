@@ -1,8 +1,8 @@
-#include "rfem/assembly/momentum.hpp"
+#include "momentum.hpp"
 
-#include "rfem/assembly/assemble.hpp"
-#include "rfem/assembly/rfe_kernels.hpp"
-#include "rfem/core/check.hpp"
+#include "assemble.hpp"
+#include "rfe_kernels.hpp"
+#include "../core/check.hpp"
 
 namespace rfem {
 

@@ -4,8 +4,8 @@
 // Without gravity and with no joint fixed to the ground (a free-floating base), both are
 // conserved: the check that vibration and base motion exchange momentum correctly. Rotors of
 // joint drives are not bodies of the model: their reflected inertia is left out.
-#include "rfem/assembly/workspace.hpp"
-#include "rfem/core/model.hpp"
+#include "workspace.hpp"
+#include "../core/model.hpp"
 
 namespace rfem {
 

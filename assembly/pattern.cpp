@@ -1,9 +1,9 @@
-#include "rfem/assembly/pattern.hpp"
+#include "pattern.hpp"
 
 #include <algorithm>
 #include <stdexcept>
 
-#include "rfem/core/check.hpp"
+#include "../core/check.hpp"
 
 namespace rfem {
 

@@ -15,7 +15,7 @@
 #include <mutex>
 #include <vector>
 
-#include "rfem/core/model.hpp"
+#include "../core/model.hpp"
 
 namespace rfem {
 

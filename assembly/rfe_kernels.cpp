@@ -1,4 +1,4 @@
-#include "rfem/assembly/rfe_kernels.hpp"
+#include "rfe_kernels.hpp"
 
 namespace rfem {
 

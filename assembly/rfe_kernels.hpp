@@ -5,8 +5,8 @@
 // one pass without b-tensors. Rows of the nodes that move {r} (`ancestors`, core/kinematics.hpp) are
 // returned as 4×4 "moment" matrices that the caller contracts with Ξ_j: ε_j = tr(Ξ_j Y),
 // M_jl = tr(Ξ_j G Ξ_lᵀ), gravity g e₃ᵀ Ξ_j s.
-#include "rfem/core/kinematics.hpp"
-#include "rfem/core/rotation.hpp"
+#include "../core/kinematics.hpp"
+#include "../core/rotation.hpp"
 
 namespace rfem {
 

@@ -1,4 +1,4 @@
-#include "rfem/assembly/sde_kernels.hpp"
+#include "sde_kernels.hpp"
 
 namespace rfem {
 

@@ -3,8 +3,8 @@
 // Relative displacement Δx = p_right − p_left (sde axes = link axes), rotation difference
 // Δφ = φ_right − φ_left. V = ½ Δxᵀ diag(c) Δx + ½ Δφᵀ diag(k) Δφ; damping d = β c, β k.
 // Coordinates are the 12 of [rfe left; rfe right]; rfe_0 (left = −1) enters with zeros.
-#include "rfem/core/link.hpp"
-#include "rfem/core/rotation.hpp"
+#include "../core/link.hpp"
+#include "../core/rotation.hpp"
 
 namespace rfem {
 

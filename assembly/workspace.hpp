@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "rfem/core/kinematics.hpp"
+#include "../core/kinematics.hpp"
 
 namespace rfem {
 

@@ -14,10 +14,10 @@
 #include <memory>
 #include <random>
 
-#include "rfem/assembly/assemble.hpp"
-#include "rfem/cases/case_file.hpp"
-#include "rfem/core/rotation.hpp"
-#include "rfem/solvers/newton_system.hpp"
+#include "../assembly/assemble.hpp"
+#include "../cases/case_file.hpp"
+#include "../core/rotation.hpp"
+#include "../solvers/newton_system.hpp"
 
 using namespace rfem;
 

@@ -1,11 +1,11 @@
-#include "rfem/cases/case_file.hpp"
-#include "rfem/solvers/modes.hpp"
+#include "case_file.hpp"
+#include "../solvers/modes.hpp"
 
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
 
-#include "rfem/cases/case_reading_impl.hpp"
+#include "case_reading_impl.hpp"
 
 namespace rfem {
 

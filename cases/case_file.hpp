@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "rfem/cases/names.hpp"
-#include "rfem/cases/sensor_spec.hpp"
-#include "rfem/core/model.hpp"
-#include "rfem/solvers/integrator.hpp"
-#include "rfem/solvers/statics.hpp"
+#include "names.hpp"
+#include "sensor_spec.hpp"
+#include "../core/model.hpp"
+#include "../solvers/integrator.hpp"
+#include "../solvers/statics.hpp"
 
 namespace rfem {
 

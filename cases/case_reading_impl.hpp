@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "rfem/cases/case_file.hpp"
+#include "case_file.hpp"
 
 namespace rfem::reading {
 

@@ -1,4 +1,4 @@
-#include "rfem/cases/names.hpp"
+#include "names.hpp"
 
 #include <array>
 #include <utility>

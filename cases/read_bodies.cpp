@@ -1,8 +1,8 @@
 // Materials, sections, rigid bodies and joint drives of a case file.
 #include <cmath>
 
-#include "rfem/cases/case_reading_impl.hpp"
-#include "rfem/core/rotation.hpp"
+#include "case_reading_impl.hpp"
+#include "../core/rotation.hpp"
 
 namespace rfem::reading {
 

@@ -2,7 +2,7 @@
 #include <cmath>
 #include <fstream>
 
-#include "rfem/cases/case_reading_impl.hpp"
+#include "case_reading_impl.hpp"
 
 namespace rfem::reading {
 

@@ -2,8 +2,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "rfem/cases/case_reading_impl.hpp"
-#include "rfem/solvers/modes.hpp"
+#include "case_reading_impl.hpp"
+#include "../solvers/modes.hpp"
 
 namespace rfem::reading {
 

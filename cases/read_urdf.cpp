@@ -18,9 +18,9 @@
 #include <map>
 #include <mutex>
 
-#include "rfem/cases/case_reading_impl.hpp"
-#include "rfem/core/link.hpp"
-#include "rfem/core/rotation.hpp"
+#include "case_reading_impl.hpp"
+#include "../core/link.hpp"
+#include "../core/rotation.hpp"
 
 namespace rfem::reading {
 

@@ -1,4 +1,4 @@
-#include "rfem/cases/sweep_file.hpp"
+#include "sweep_file.hpp"
 
 #include <fmt/core.h>
 
@@ -7,7 +7,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "rfem/cases/case_reading_impl.hpp"
+#include "case_reading_impl.hpp"
 
 namespace rfem {
 

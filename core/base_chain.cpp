@@ -1,6 +1,6 @@
-#include "rfem/core/base_chain.hpp"
+#include "base_chain.hpp"
 
-#include "rfem/core/rotation.hpp"
+#include "rotation.hpp"
 
 namespace rfem {
 

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "rfem/core/joint_drive.hpp"
-#include "rfem/core/mounting.hpp"
-#include "rfem/core/types.hpp"
+#include "joint_drive.hpp"
+#include "mounting.hpp"
+#include "types.hpp"
 
 namespace rfem {
 

@@ -1,4 +1,4 @@
-#include "rfem/core/check.hpp"
+#include "check.hpp"
 
 #include <cmath>
 #include <sstream>

@@ -1,8 +1,8 @@
-#include "rfem/core/joint_drive.hpp"
+#include "joint_drive.hpp"
 
 #include <cmath>
 
-#include "rfem/core/check.hpp"
+#include "check.hpp"
 
 namespace rfem {
 

@@ -1,6 +1,6 @@
-#include "rfem/core/kinematics.hpp"
+#include "kinematics.hpp"
 
-#include "rfem/core/check.hpp"
+#include "check.hpp"
 
 namespace rfem {
 

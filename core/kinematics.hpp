@@ -5,7 +5,7 @@
 //   ∂W_i/∂q_j = Ξ_j W_i,  ∂²W_i/∂q_j∂q_l = Ξ_j Ξ_l W_i  (j an ancestor of l, or j = l),
 // so Ẇ = Ω W with Ω = Σ Ξ_j q̇_j, and Ẅ = (Σ Ξ_j q̈_j + Σ_jl Ξ_min Ξ_max q̇_j q̇_l) W over the path
 // from the root (docs/formulation.md §3).
-#include "rfem/core/model.hpp"
+#include "model.hpp"
 
 namespace rfem {
 

@@ -1,11 +1,11 @@
-#include "rfem/core/link.hpp"
+#include "link.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-#include "rfem/core/check.hpp"
+#include "check.hpp"
 
 namespace rfem {
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "rfem/core/section.hpp"
+#include "section.hpp"
 
 namespace rfem {
 

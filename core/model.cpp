@@ -1,10 +1,10 @@
-#include "rfem/core/model.hpp"
+#include "model.hpp"
 
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-#include "rfem/core/check.hpp"
+#include "check.hpp"
 
 namespace rfem {
 

@@ -14,9 +14,9 @@
 // this layout: other code asks rfe_index / joint_index instead of computing offsets.
 #include <string>
 
-#include "rfem/core/base_chain.hpp"
-#include "rfem/core/link.hpp"
-#include "rfem/core/mounting.hpp"
+#include "base_chain.hpp"
+#include "link.hpp"
+#include "mounting.hpp"
 
 namespace rfem {
 

@@ -1,8 +1,8 @@
-#include "rfem/core/mounting.hpp"
+#include "mounting.hpp"
 
 #include <algorithm>
 
-#include "rfem/core/check.hpp"
+#include "check.hpp"
 
 namespace rfem {
 

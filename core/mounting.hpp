@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "rfem/core/types.hpp"
+#include "types.hpp"
 
 namespace rfem {
 

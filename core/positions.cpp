@@ -1,8 +1,8 @@
-#include "rfem/core/positions.hpp"
+#include "positions.hpp"
 
-#include "rfem/core/check.hpp"
-#include "rfem/core/kinematics.hpp"
-#include "rfem/core/rotation.hpp"
+#include "check.hpp"
+#include "kinematics.hpp"
+#include "rotation.hpp"
 
 namespace rfem {
 

@@ -1,7 +1,7 @@
 #pragma once
 // Where the points of a model are at full coordinates q (flexible first, joints last): link tips,
 // points along a link's elastic axis, joint frames; and the paper's tip deflections.
-#include "rfem/core/model.hpp"
+#include "model.hpp"
 
 namespace rfem {
 

@@ -1,4 +1,4 @@
-#include "rfem/core/rotation.hpp"
+#include "rotation.hpp"
 
 #include <cmath>
 

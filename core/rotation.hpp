@@ -5,7 +5,7 @@
 // (3) mapped to our x, so torsion is the innermost rotation, about the rfe's own axis. (With the
 // torsion outermost, turning a bent rfe about the axis of {r} would swing its attachment points
 // against the stiff shear springs and tilt its large bending inertia into the torsion row.)
-#include "rfem/core/types.hpp"
+#include "types.hpp"
 
 namespace rfem {
 

@@ -1,8 +1,8 @@
-#include "rfem/core/section.hpp"
+#include "section.hpp"
 
 #include <cmath>
 
-#include "rfem/core/check.hpp"
+#include "check.hpp"
 
 namespace rfem {
 

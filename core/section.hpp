@@ -2,7 +2,7 @@
 // Materials and beam cross-sections of a flexible link. SI units.
 #include <string>
 
-#include "rfem/core/types.hpp"
+#include "types.hpp"
 
 namespace rfem {
 

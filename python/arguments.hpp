@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "rfem/cases/case_file.hpp"
+#include "../cases/case_file.hpp"
 
 namespace rfem::pyargs {
 

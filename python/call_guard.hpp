@@ -7,7 +7,7 @@
 
 #include <csignal>
 
-#include "rfem/studies/runs.hpp"
+#include "../studies/runs.hpp"
 
 namespace rfem::pyguard {
 

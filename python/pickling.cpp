@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "rfem/studies/common.hpp"
+#include "../studies/common.hpp"
 #include "rfem/version.hpp"
 
 namespace rfem::pyorigin {

@@ -8,10 +8,10 @@
 
 #include <memory>
 
-#include "rfem/cases/case_file.hpp"
-#include "rfem/core/model.hpp"
-#include "rfem/studies/runs.hpp"
-#include "rfem/studies/sweep.hpp"
+#include "../cases/case_file.hpp"
+#include "../core/model.hpp"
+#include "../studies/runs.hpp"
+#include "../studies/sweep.hpp"
 
 namespace rfem::pyorigin {
 

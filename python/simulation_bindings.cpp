@@ -15,11 +15,11 @@
 #include "pickling.hpp"
 #include <pybind11/eigen.h>
 
-#include "rfem/results/writer.hpp"
-#include "rfem/studies/inputs.hpp"
-#include "rfem/studies/recorders.hpp"
-#include "rfem/studies/run_file.hpp"
-#include "rfem/studies/simulation.hpp"
+#include "../results/writer.hpp"
+#include "../studies/inputs.hpp"
+#include "../studies/recorders.hpp"
+#include "../studies/run_file.hpp"
+#include "../studies/simulation.hpp"
 
 namespace py = pybind11;
 using namespace rfem;

@@ -14,8 +14,8 @@
 
 #include "arguments.hpp"
 #include "pickling.hpp"
-#include "rfem/solvers/run_status.hpp"
-#include "rfem/studies/sweep.hpp"
+#include "../solvers/run_status.hpp"
+#include "../studies/sweep.hpp"
 
 namespace py = pybind11;
 using namespace rfem;

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <cstring>
 
-#include "rfem/results/writer_impl.hpp"
+#include "writer_impl.hpp"
 
 namespace rfem {
 

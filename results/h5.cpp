@@ -1,4 +1,4 @@
-#include "rfem/results/h5_impl.hpp"
+#include "h5_impl.hpp"
 
 #include <algorithm>
 

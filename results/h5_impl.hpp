@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "rfem/results/errors.hpp"
+#include "errors.hpp"
 
 namespace rfem::h5 {
 

@@ -1,7 +1,7 @@
-#include "rfem/results/layout.hpp"
+#include "layout.hpp"
 
-#include "rfem/core/check.hpp"
-#include "rfem/core/positions.hpp"
+#include "../core/check.hpp"
+#include "../core/positions.hpp"
 
 namespace rfem {
 

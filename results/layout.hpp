@@ -6,8 +6,8 @@
 #include <utility>
 #include <vector>
 
-#include "rfem/core/model.hpp"
-#include "rfem/solvers/equations.hpp"
+#include "../core/model.hpp"
+#include "../solvers/equations.hpp"
 
 namespace rfem {
 

@@ -1,6 +1,6 @@
-#include "rfem/results/reader.hpp"
+#include "reader.hpp"
 
-#include "rfem/results/h5_impl.hpp"
+#include "h5_impl.hpp"
 
 namespace rfem {
 

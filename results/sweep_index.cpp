@@ -1,4 +1,4 @@
-#include "rfem/results/sweep_index.hpp"
+#include "sweep_index.hpp"
 
 #include <fcntl.h>
 #include <fmt/core.h>
@@ -10,10 +10,10 @@
 #include <cstring>
 #include <filesystem>
 
-#include "rfem/core/check.hpp"
-#include "rfem/results/errors.hpp"
-#include "rfem/results/reader.hpp"
-#include "rfem/results/writer.hpp"
+#include "../core/check.hpp"
+#include "errors.hpp"
+#include "reader.hpp"
+#include "writer.hpp"
 
 namespace rfem {
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "rfem/cases/sweep_file.hpp"
-#include "rfem/solvers/run_status.hpp"
+#include "../cases/sweep_file.hpp"
+#include "../solvers/run_status.hpp"
 
 namespace rfem {
 

@@ -1,4 +1,4 @@
-#include "rfem/results/writer.hpp"
+#include "writer.hpp"
 
 #include <fcntl.h>
 #include <sys/resource.h>
@@ -14,7 +14,7 @@
 #include <thread>
 #include <variant>
 
-#include "rfem/results/writer_impl.hpp"
+#include "writer_impl.hpp"
 #include "rfem/version.hpp"
 
 namespace rfem {

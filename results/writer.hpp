@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "rfem/results/errors.hpp"
-#include "rfem/results/layout.hpp"
-#include "rfem/results/reader.hpp"
-#include "rfem/solvers/integrator.hpp"
-#include "rfem/solvers/refinement.hpp"
+#include "errors.hpp"
+#include "layout.hpp"
+#include "reader.hpp"
+#include "../solvers/integrator.hpp"
+#include "../solvers/refinement.hpp"
 
 namespace rfem {
 

@@ -12,8 +12,8 @@
 #include <optional>
 #include <variant>
 
-#include "rfem/results/h5_impl.hpp"
-#include "rfem/results/writer.hpp"
+#include "h5_impl.hpp"
+#include "writer.hpp"
 
 namespace rfem {
 

@@ -1,12 +1,12 @@
-#include "rfem/results/xdmf.hpp"
+#include "xdmf.hpp"
 
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
-#include "rfem/results/errors.hpp"
-#include "rfem/results/reader.hpp"
+#include "errors.hpp"
+#include "reader.hpp"
 
 namespace rfem {
 

@@ -14,9 +14,9 @@
 #include <cstdlib>
 #include <stdexcept>
 
-#include "rfem/core/check.hpp"
-#include "rfem/solvers/stepper.hpp"
-#include "rfem/solvers/sundials_impl.hpp"
+#include "../core/check.hpp"
+#include "stepper.hpp"
+#include "sundials_impl.hpp"
 
 namespace rfem {
 

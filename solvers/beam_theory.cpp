@@ -1,4 +1,4 @@
-#include "rfem/solvers/beam_theory.hpp"
+#include "beam_theory.hpp"
 
 #include <cmath>
 

@@ -1,8 +1,8 @@
 #pragma once
 // Exact results for a uniform cantilever (Euler–Bernoulli bending, rods in tension and torsion,
 // Timoshenko shear deflection), the references rfem's discretisation converges to.
-#include "rfem/core/link.hpp"
-#include "rfem/solvers/modes.hpp"
+#include "../core/link.hpp"
+#include "modes.hpp"
 
 namespace rfem::beam {
 

@@ -1,4 +1,4 @@
-#include "rfem/solvers/chain_solver.hpp"
+#include "chain_solver.hpp"
 
 #include <omp.h>
 
@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "rfem/core/check.hpp"
+#include "../core/check.hpp"
 
 namespace rfem {
 

@@ -16,7 +16,7 @@
 #include <memory>
 #include <vector>
 
-#include "rfem/solvers/linear_solver.hpp"
+#include "linear_solver.hpp"
 
 namespace rfem {
 

@@ -1,11 +1,11 @@
-#include "rfem/solvers/cholmod_solver.hpp"
+#include "cholmod_solver.hpp"
 
 #include <cholmod.h>
 
 #include <algorithm>
 #include <stdexcept>
 
-#include "rfem/core/check.hpp"
+#include "../core/check.hpp"
 
 namespace rfem {
 

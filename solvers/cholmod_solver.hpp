@@ -5,7 +5,7 @@
 #include <memory>
 #include <vector>
 
-#include "rfem/solvers/linear_solver.hpp"
+#include "linear_solver.hpp"
 
 struct cholmod_common_struct;
 struct cholmod_sparse_struct;

@@ -1,4 +1,4 @@
-#include "rfem/solvers/equations.hpp"
+#include "equations.hpp"
 
 #include <omp.h>
 
@@ -9,10 +9,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "rfem/core/check.hpp"
-#include "rfem/solvers/mass_solve.hpp"
-#include "rfem/solvers/statics.hpp"
-#include "rfem/solvers/team_parts.hpp"
+#include "../core/check.hpp"
+#include "mass_solve.hpp"
+#include "statics.hpp"
+#include "team_parts.hpp"
 
 namespace rfem {
 

@@ -11,12 +11,12 @@
 // them, and the full coordinates are q0 + P q_u. Movable, not copyable.
 #include <memory>
 
-#include "rfem/assembly/assemble.hpp"
-#include "rfem/assembly/momentum.hpp"
-#include "rfem/solvers/inputs.hpp"
-#include "rfem/solvers/newton_system.hpp"
-#include "rfem/solvers/run_status.hpp"
-#include "rfem/solvers/thread_governor.hpp"
+#include "../assembly/assemble.hpp"
+#include "../assembly/momentum.hpp"
+#include "inputs.hpp"
+#include "newton_system.hpp"
+#include "run_status.hpp"
+#include "thread_governor.hpp"
 
 namespace rfem {
 

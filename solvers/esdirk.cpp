@@ -20,10 +20,10 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "rfem/core/check.hpp"
-#include "rfem/solvers/esdirk_stepper.hpp"
-#include "rfem/solvers/esdirk_tableau.hpp"
-#include "rfem/solvers/team_parts.hpp"
+#include "../core/check.hpp"
+#include "esdirk_stepper.hpp"
+#include "esdirk_tableau.hpp"
+#include "team_parts.hpp"
 
 namespace rfem {
 

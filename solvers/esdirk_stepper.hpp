@@ -3,7 +3,7 @@
 // step-size history included, carried from one advance() to the next.
 #include <memory>
 
-#include "rfem/solvers/stepper.hpp"
+#include "stepper.hpp"
 
 namespace rfem {
 

@@ -1,4 +1,4 @@
-#include "rfem/solvers/esdirk_tableau.hpp"
+#include "esdirk_tableau.hpp"
 
 #include <cstdio>  // before arkode_butcher.h, which uses FILE without including it
 
@@ -9,7 +9,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "rfem/solvers/team_parts.hpp"
+#include "team_parts.hpp"
 
 namespace rfem::esdirk {
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "rfem/core/types.hpp"
+#include "../core/types.hpp"
 
 namespace rfem::esdirk {
 

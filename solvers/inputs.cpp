@@ -1,4 +1,4 @@
-#include "rfem/solvers/inputs.hpp"
+#include "inputs.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -10,7 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "rfem/core/check.hpp"
+#include "../core/check.hpp"
 
 namespace rfem {
 

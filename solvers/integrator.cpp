@@ -1,12 +1,12 @@
-#include "rfem/solvers/integrator.hpp"
+#include "integrator.hpp"
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
-#include "rfem/core/check.hpp"
-#include "rfem/solvers/esdirk_stepper.hpp"
+#include "../core/check.hpp"
+#include "esdirk_stepper.hpp"
 
 namespace rfem {
 

@@ -14,8 +14,8 @@
 #include <memory>
 #include <string>
 
-#include "rfem/solvers/equations.hpp"
-#include "rfem/solvers/run_status.hpp"
+#include "equations.hpp"
+#include "run_status.hpp"
 
 namespace rfem {
 

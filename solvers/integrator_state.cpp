@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "rfem/solvers/integrator.hpp"
+#include "integrator.hpp"
 
 namespace rfem {
 

@@ -1,7 +1,7 @@
-#include "rfem/solvers/linear_solver.hpp"
+#include "linear_solver.hpp"
 
-#include "rfem/solvers/chain_solver.hpp"
-#include "rfem/solvers/cholmod_solver.hpp"
+#include "chain_solver.hpp"
+#include "cholmod_solver.hpp"
 
 namespace rfem {
 

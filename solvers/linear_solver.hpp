@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "rfem/assembly/pattern.hpp"
-#include "rfem/core/types.hpp"
+#include "../assembly/pattern.hpp"
+#include "../core/types.hpp"
 
 namespace rfem {
 

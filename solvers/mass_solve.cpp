@@ -1,5 +1,5 @@
-#include "rfem/solvers/mass_solve.hpp"
-#include "rfem/core/check.hpp"
+#include "mass_solve.hpp"
+#include "../core/check.hpp"
 
 namespace rfem {
 

@@ -4,7 +4,7 @@
 // docs/formulation.md §4), so with the border b (carrying rfes, free joints)
 // a_b = (M_bb − Σ B_kᵀ M_kk⁻¹ B_k)⁻¹ (b_b − Σ B_kᵀ M_kk⁻¹ b_k) and a_k = M_kk⁻¹ (b_k − B_k a_b),
 // with 6×6 solves per rfe and one nb×nb solve: O(n) work, no sparse factor to keep.
-#include "rfem/assembly/assemble.hpp"
+#include "../assembly/assemble.hpp"
 
 namespace rfem {
 

@@ -1,4 +1,4 @@
-#include "rfem/solvers/modes.hpp"
+#include "modes.hpp"
 
 #include <Spectra/SymEigsShiftSolver.h>
 #include <Spectra/SymGEigsShiftSolver.h>
@@ -13,13 +13,13 @@
 
 #include <stdexcept>
 
-#include "rfem/assembly/assemble.hpp"
-#include "rfem/assembly/rfe_kernels.hpp"
-#include "rfem/solvers/cholmod_solver.hpp"
-#include "rfem/solvers/linear_solver.hpp"
-#include "rfem/solvers/reduction.hpp"
-#include "rfem/solvers/statics.hpp"
-#include "rfem/core/check.hpp"
+#include "../assembly/assemble.hpp"
+#include "../assembly/rfe_kernels.hpp"
+#include "cholmod_solver.hpp"
+#include "linear_solver.hpp"
+#include "reduction.hpp"
+#include "statics.hpp"
+#include "../core/check.hpp"
 
 namespace rfem {
 

@@ -7,8 +7,8 @@
 // ones. Free joints without stiffness give rigid-body modes (ω = 0, kind Rigid).
 #include <string>
 
-#include "rfem/assembly/workspace.hpp"
-#include "rfem/core/model.hpp"
+#include "../assembly/workspace.hpp"
+#include "../core/model.hpp"
 
 namespace rfem {
 

@@ -1,9 +1,9 @@
-#include "rfem/solvers/newton_system.hpp"
-#include "rfem/core/check.hpp"
+#include "newton_system.hpp"
+#include "../core/check.hpp"
 
 #include <stdexcept>
 
-#include "rfem/solvers/mass_solve.hpp"
+#include "mass_solve.hpp"
 
 namespace rfem {
 

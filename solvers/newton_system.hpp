@@ -17,9 +17,9 @@
 // (thread policy and scratch) is an argument of setup(). Movable, not copyable.
 #include <memory>
 
-#include "rfem/assembly/assemble.hpp"
-#include "rfem/solvers/linear_solver.hpp"
-#include "rfem/solvers/reduction.hpp"
+#include "../assembly/assemble.hpp"
+#include "linear_solver.hpp"
+#include "reduction.hpp"
 
 namespace rfem {
 

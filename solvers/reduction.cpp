@@ -1,10 +1,10 @@
-#include "rfem/solvers/reduction.hpp"
+#include "reduction.hpp"
 
 #include <algorithm>
 #include <stdexcept>
 
-#include "rfem/solvers/modes.hpp"
-#include "rfem/solvers/team_parts.hpp"
+#include "modes.hpp"
+#include "team_parts.hpp"
 
 namespace rfem {
 

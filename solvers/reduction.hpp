@@ -22,9 +22,9 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
-#include "rfem/assembly/pattern.hpp"
-#include "rfem/assembly/workspace.hpp"
-#include "rfem/core/model.hpp"
+#include "../assembly/pattern.hpp"
+#include "../assembly/workspace.hpp"
+#include "../core/model.hpp"
 
 namespace rfem {
 

@@ -1,4 +1,4 @@
-#include "rfem/solvers/refinement.hpp"
+#include "refinement.hpp"
 
 #include <cmath>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include "rfem/solvers/run_status.hpp"
+#include "run_status.hpp"
 
 #include <cstdlib>
 #include <ostream>

@@ -1,17 +1,17 @@
-#include "rfem/solvers/statics.hpp"
-#include "rfem/core/check.hpp"
+#include "statics.hpp"
+#include "../core/check.hpp"
 
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-#include "rfem/assembly/assemble.hpp"
-#include "rfem/core/kinematics.hpp"
-#include "rfem/core/positions.hpp"
-#include "rfem/core/rotation.hpp"
-#include "rfem/solvers/chain_solver.hpp"
-#include "rfem/solvers/cholmod_solver.hpp"
-#include "rfem/solvers/reduction.hpp"
+#include "../assembly/assemble.hpp"
+#include "../core/kinematics.hpp"
+#include "../core/positions.hpp"
+#include "../core/rotation.hpp"
+#include "chain_solver.hpp"
+#include "cholmod_solver.hpp"
+#include "reduction.hpp"
 
 namespace rfem {
 

@@ -3,9 +3,9 @@
 // steadily rotating base, given joint rates): f_el(q) + f_g(q) + h(q, v_b) = Q_tip(q), solved by
 // Newton iteration with the CHOLMOD factor of the stiffness (elastic with geometric term, gravity,
 // centrifugal), with load stepping when a full step does not converge.
-#include "rfem/core/model.hpp"
-#include "rfem/core/positions.hpp"
-#include "rfem/assembly/workspace.hpp"
+#include "../core/model.hpp"
+#include "../core/positions.hpp"
+#include "../assembly/workspace.hpp"
 
 namespace rfem {
 

@@ -6,7 +6,7 @@
 // outputs on the run's grid (output_time) delivered to the emitter as the steps pass them.
 #include <memory>
 
-#include "rfem/solvers/integrator.hpp"
+#include "integrator.hpp"
 
 namespace rfem {
 

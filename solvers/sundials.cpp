@@ -3,7 +3,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "rfem/solvers/sundials_impl.hpp"
+#include "sundials_impl.hpp"
 
 namespace rfem::sundials {
 

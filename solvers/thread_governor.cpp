@@ -1,4 +1,4 @@
-#include "rfem/solvers/thread_governor.hpp"
+#include "thread_governor.hpp"
 
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-#include "rfem/studies/checkpoints.hpp"
+#include "checkpoints.hpp"
 
 #include <cstdint>
 #include <stdexcept>

@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "rfem/solvers/integrator.hpp"
+#include "../solvers/integrator.hpp"
 
 namespace rfem {
 

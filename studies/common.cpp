@@ -1,4 +1,4 @@
-#include "rfem/studies/common.hpp"
+#include "common.hpp"
 
 #include <cmath>
 

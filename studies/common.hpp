@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "rfem/cases/case_file.hpp"
+#include "../cases/case_file.hpp"
 
 namespace rfem {
 

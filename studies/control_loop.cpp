@@ -7,8 +7,8 @@
 
 #include <fmt/format.h>
 
-#include "rfem/core/check.hpp"
-#include "rfem/studies/simulation.hpp"
+#include "../core/check.hpp"
+#include "simulation.hpp"
 
 namespace rfem {
 

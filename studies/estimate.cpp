@@ -1,4 +1,4 @@
-#include "rfem/studies/estimate.hpp"
+#include "estimate.hpp"
 
 #include <fmt/core.h>
 

@@ -1,8 +1,8 @@
 #pragma once
 // Whether a run can be afforded before it starts: its memory against what the machine has, and
 // for large runs the timed cost of a step.
-#include "rfem/cases/case_file.hpp"
-#include "rfem/solvers/integrator.hpp"
+#include "../cases/case_file.hpp"
+#include "../solvers/integrator.hpp"
 
 namespace rfem {
 

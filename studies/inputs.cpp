@@ -1,4 +1,4 @@
-#include "rfem/studies/inputs.hpp"
+#include "inputs.hpp"
 
 #include <fmt/core.h>
 
@@ -7,9 +7,9 @@
 #include <limits>
 #include <mutex>
 
-#include "rfem/assembly/assemble.hpp"
-#include "rfem/results/reader.hpp"
-#include "rfem/solvers/run_status.hpp"
+#include "../assembly/assemble.hpp"
+#include "../results/reader.hpp"
+#include "../solvers/run_status.hpp"
 
 namespace rfem {
 

@@ -4,9 +4,9 @@
 #include <memory>
 #include <vector>
 
-#include "rfem/cases/case_file.hpp"
-#include "rfem/solvers/inputs.hpp"
-#include "rfem/studies/common.hpp"
+#include "../cases/case_file.hpp"
+#include "../solvers/inputs.hpp"
+#include "common.hpp"
 
 namespace rfem {
 

@@ -1,10 +1,10 @@
-#include "rfem/studies/linear_jacobian.hpp"
+#include "linear_jacobian.hpp"
 
 #include <algorithm>
 #include <array>
 #include <utility>
 
-#include "rfem/core/check.hpp"
+#include "../core/check.hpp"
 
 namespace rfem {
 

@@ -18,9 +18,9 @@
 #include <utility>
 #include <vector>
 
-#include "rfem/assembly/assemble.hpp"
-#include "rfem/solvers/inputs.hpp"
-#include "rfem/solvers/reduction.hpp"
+#include "../assembly/assemble.hpp"
+#include "../solvers/inputs.hpp"
+#include "../solvers/reduction.hpp"
 
 namespace rfem {
 

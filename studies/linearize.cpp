@@ -1,4 +1,4 @@
-#include "rfem/studies/linearize.hpp"
+#include "linearize.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
@@ -15,11 +15,11 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "rfem/results/reader.hpp"
-#include "rfem/results/writer.hpp"
-#include "rfem/core/positions.hpp"
-#include "rfem/studies/sensors.hpp"
-#include "rfem/studies/simulation.hpp"
+#include "../results/reader.hpp"
+#include "../results/writer.hpp"
+#include "../core/positions.hpp"
+#include "sensors.hpp"
+#include "simulation.hpp"
 
 namespace rfem {
 

@@ -16,11 +16,11 @@
 #include <utility>
 #include <vector>
 
-#include "rfem/core/model.hpp"
-#include "rfem/solvers/equations.hpp"
-#include "rfem/solvers/reduction.hpp"
-#include "rfem/studies/linear_jacobian.hpp"
-#include "rfem/studies/simulation.hpp"
+#include "../core/model.hpp"
+#include "../solvers/equations.hpp"
+#include "../solvers/reduction.hpp"
+#include "linear_jacobian.hpp"
+#include "simulation.hpp"
 
 namespace rfem {
 

@@ -1,11 +1,11 @@
-#include "rfem/studies/modes_study.hpp"
+#include "modes_study.hpp"
 
 #include <fmt/core.h>
 
 #include <cmath>
 
-#include "rfem/solvers/beam_theory.hpp"
-#include "rfem/studies/validity.hpp"
+#include "../solvers/beam_theory.hpp"
+#include "validity.hpp"
 
 namespace rfem {
 

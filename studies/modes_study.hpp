@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "rfem/results/writer.hpp"
-#include "rfem/solvers/modes.hpp"
-#include "rfem/studies/common.hpp"
+#include "../results/writer.hpp"
+#include "../solvers/modes.hpp"
+#include "common.hpp"
 
 namespace rfem {
 

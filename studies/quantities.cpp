@@ -1,4 +1,4 @@
-#include "rfem/studies/quantities.hpp"
+#include "quantities.hpp"
 
 #include <fmt/core.h>
 
@@ -7,10 +7,10 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "rfem/core/positions.hpp"
-#include "rfem/studies/checkpoints.hpp"
-#include "rfem/solvers/modes.hpp"
-#include "rfem/solvers/statics.hpp"
+#include "../core/positions.hpp"
+#include "checkpoints.hpp"
+#include "../solvers/modes.hpp"
+#include "../solvers/statics.hpp"
 
 namespace rfem {
 

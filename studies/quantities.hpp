@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "rfem/solvers/equations.hpp"
-#include "rfem/studies/common.hpp"
-#include "rfem/studies/runs.hpp"
+#include "../solvers/equations.hpp"
+#include "common.hpp"
+#include "runs.hpp"
 
 namespace rfem {
 

@@ -1,7 +1,7 @@
-#include "rfem/studies/recorders.hpp"
-#include "rfem/studies/checkpoints.hpp"
+#include "recorders.hpp"
+#include "checkpoints.hpp"
 
-#include "rfem/results/xdmf.hpp"
+#include "../results/xdmf.hpp"
 
 namespace rfem {
 

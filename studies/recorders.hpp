@@ -3,8 +3,8 @@
 // the run goes: results/writer.hpp).
 #include <memory>
 
-#include "rfem/results/writer.hpp"
-#include "rfem/studies/runs.hpp"
+#include "../results/writer.hpp"
+#include "runs.hpp"
 
 namespace rfem {
 

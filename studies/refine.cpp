@@ -1,4 +1,4 @@
-#include "rfem/studies/refine.hpp"
+#include "refine.hpp"
 
 #include <fmt/core.h>
 
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <map>
 
-#include "rfem/studies/inputs.hpp"
+#include "inputs.hpp"
 
 namespace rfem {
 

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "rfem/solvers/refinement.hpp"
-#include "rfem/studies/quantities.hpp"
-#include "rfem/studies/runs.hpp"
+#include "../solvers/refinement.hpp"
+#include "quantities.hpp"
+#include "runs.hpp"
 
 namespace rfem {
 

@@ -1,15 +1,15 @@
-#include "rfem/studies/resume.hpp"
+#include "resume.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
 
-#include "rfem/results/writer.hpp"
-#include "rfem/studies/checkpoints.hpp"
-#include "rfem/studies/inputs.hpp"
-#include "rfem/studies/recorders.hpp"
-#include "rfem/studies/sensors.hpp"
+#include "../results/writer.hpp"
+#include "checkpoints.hpp"
+#include "inputs.hpp"
+#include "recorders.hpp"
+#include "sensors.hpp"
 
 namespace rfem {
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "rfem/studies/runs.hpp"
+#include "runs.hpp"
 
 namespace rfem {
 

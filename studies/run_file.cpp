@@ -1,11 +1,11 @@
-#include "rfem/studies/run_file.hpp"
+#include "run_file.hpp"
 
-#include "rfem/results/errors.hpp"
-#include "rfem/results/writer.hpp"
-#include "rfem/studies/common.hpp"
-#include "rfem/studies/inputs.hpp"
-#include "rfem/studies/recorders.hpp"
-#include "rfem/studies/simulation.hpp"
+#include "../results/errors.hpp"
+#include "../results/writer.hpp"
+#include "common.hpp"
+#include "inputs.hpp"
+#include "recorders.hpp"
+#include "simulation.hpp"
 
 namespace rfem {
 

@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
-#include "rfem/studies/linearize.hpp"
-#include "rfem/studies/modes_study.hpp"
-#include "rfem/studies/refine.hpp"
-#include "rfem/studies/simulation.hpp"
-#include "rfem/studies/runs.hpp"
+#include "linearize.hpp"
+#include "modes_study.hpp"
+#include "refine.hpp"
+#include "simulation.hpp"
+#include "runs.hpp"
 
 namespace rfem {
 

@@ -1,18 +1,18 @@
-#include "rfem/studies/runs.hpp"
+#include "runs.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 
-#include "rfem/core/check.hpp"
-#include "rfem/core/positions.hpp"
-#include "rfem/studies/checkpoints.hpp"
-#include "rfem/studies/inputs.hpp"
-#include "rfem/studies/run_file.hpp"
-#include "rfem/studies/sensors.hpp"
-#include "rfem/studies/simulation.hpp"
-#include "rfem/studies/validity.hpp"
+#include "../core/check.hpp"
+#include "../core/positions.hpp"
+#include "checkpoints.hpp"
+#include "inputs.hpp"
+#include "run_file.hpp"
+#include "sensors.hpp"
+#include "simulation.hpp"
+#include "validity.hpp"
 
 namespace rfem {
 

@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "rfem/cases/case_file.hpp"
-#include "rfem/results/layout.hpp"
-#include "rfem/results/reader.hpp"
-#include "rfem/solvers/integrator.hpp"
-#include "rfem/studies/common.hpp"
+#include "../cases/case_file.hpp"
+#include "../results/layout.hpp"
+#include "../results/reader.hpp"
+#include "../solvers/integrator.hpp"
+#include "common.hpp"
 
 namespace rfem {
 

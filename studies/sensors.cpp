@@ -1,9 +1,9 @@
-#include "rfem/studies/sensors.hpp"
+#include "sensors.hpp"
 
 #include <cmath>
 #include <stdexcept>
 
-#include "rfem/core/positions.hpp"
+#include "../core/positions.hpp"
 
 namespace rfem {
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "rfem/cases/case_file.hpp"
+#include "../cases/case_file.hpp"
 
 namespace rfem {
 

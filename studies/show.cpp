@@ -1,14 +1,14 @@
-#include "rfem/studies/show.hpp"
+#include "show.hpp"
 
 #include <fmt/core.h>
 
 #include <algorithm>
 #include <functional>
 
-#include "rfem/solvers/equations.hpp"
-#include "rfem/solvers/modes.hpp"
-#include "rfem/solvers/reduction.hpp"
-#include "rfem/studies/inputs.hpp"
+#include "../solvers/equations.hpp"
+#include "../solvers/modes.hpp"
+#include "../solvers/reduction.hpp"
+#include "inputs.hpp"
 
 namespace rfem {
 

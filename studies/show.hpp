@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "rfem/studies/common.hpp"
+#include "common.hpp"
 
 namespace rfem {
 

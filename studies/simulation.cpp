@@ -1,19 +1,19 @@
-#include "rfem/studies/simulation.hpp"
+#include "simulation.hpp"
 
 #include <cmath>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
-#include "rfem/core/check.hpp"
-#include "rfem/core/positions.hpp"
-#include "rfem/results/errors.hpp"
-#include "rfem/results/writer.hpp"
-#include "rfem/studies/checkpoints.hpp"
-#include "rfem/studies/common.hpp"
-#include "rfem/studies/inputs.hpp"
-#include "rfem/studies/recorders.hpp"
-#include "rfem/studies/sensors.hpp"
+#include "../core/check.hpp"
+#include "../core/positions.hpp"
+#include "../results/errors.hpp"
+#include "../results/writer.hpp"
+#include "checkpoints.hpp"
+#include "common.hpp"
+#include "inputs.hpp"
+#include "recorders.hpp"
+#include "sensors.hpp"
 
 namespace rfem {
 

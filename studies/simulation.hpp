@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "rfem/studies/runs.hpp"
-#include "rfem/solvers/stepper.hpp"
+#include "runs.hpp"
+#include "../solvers/stepper.hpp"
 
 namespace rfem {
 

@@ -1,8 +1,8 @@
-#include "rfem/studies/static_study.hpp"
+#include "static_study.hpp"
 
 #include <cmath>
 
-#include "rfem/studies/validity.hpp"
+#include "validity.hpp"
 
 namespace rfem {
 

@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "rfem/assembly/assemble.hpp"
-#include "rfem/solvers/statics.hpp"
-#include "rfem/studies/common.hpp"
+#include "../assembly/assemble.hpp"
+#include "../solvers/statics.hpp"
+#include "common.hpp"
 
 namespace rfem {
 

@@ -1,4 +1,4 @@
-#include "rfem/studies/sweep.hpp"
+#include "sweep.hpp"
 
 #include <fmt/core.h>
 
@@ -11,18 +11,18 @@
 #include <numeric>
 #include <thread>
 
-#include "rfem/assembly/workspace.hpp"
+#include "../assembly/workspace.hpp"
 
-#include "rfem/core/check.hpp"
-#include "rfem/results/errors.hpp"
-#include "rfem/results/reader.hpp"
-#include "rfem/results/writer.hpp"
-#include "rfem/studies/inputs.hpp"
-#include "rfem/studies/quantities.hpp"
-#include "rfem/studies/recorders.hpp"
-#include "rfem/studies/resume.hpp"
-#include "rfem/studies/run_file.hpp"
-#include "rfem/studies/runs.hpp"
+#include "../core/check.hpp"
+#include "../results/errors.hpp"
+#include "../results/reader.hpp"
+#include "../results/writer.hpp"
+#include "inputs.hpp"
+#include "quantities.hpp"
+#include "recorders.hpp"
+#include "resume.hpp"
+#include "run_file.hpp"
+#include "runs.hpp"
 
 namespace rfem {
 

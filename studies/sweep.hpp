@@ -20,11 +20,11 @@
 #include <string>
 #include <vector>
 
-#include "rfem/cases/case_file.hpp"
-#include "rfem/cases/sweep_file.hpp"
-#include "rfem/results/sweep_index.hpp"
-#include "rfem/solvers/run_status.hpp"
-#include "rfem/studies/common.hpp"
+#include "../cases/case_file.hpp"
+#include "../cases/sweep_file.hpp"
+#include "../results/sweep_index.hpp"
+#include "../solvers/run_status.hpp"
+#include "common.hpp"
 
 namespace rfem {
 

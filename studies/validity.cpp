@@ -1,6 +1,6 @@
-#include "rfem/studies/validity.hpp"
+#include "validity.hpp"
 
-#include "rfem/core/positions.hpp"
+#include "../core/positions.hpp"
 
 #include <stdexcept>
 
@@ -8,7 +8,7 @@
 
 #include <cmath>
 
-#include "rfem/core/check.hpp"
+#include "../core/check.hpp"
 
 namespace rfem {
 

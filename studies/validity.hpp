@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "rfem/core/model.hpp"
+#include "../core/model.hpp"
 
 namespace rfem {
 

@@ -5,10 +5,10 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
-#include "rfem/assembly/assemble.hpp"
-#include "rfem/assembly/dense_reference.hpp"
-#include "rfem/solvers/cholmod_solver.hpp"
-#include "rfem/solvers/mass_solve.hpp"
+#include "../assembly/assemble.hpp"
+#include "../assembly/dense_reference.hpp"
+#include "../solvers/cholmod_solver.hpp"
+#include "../solvers/mass_solve.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

@@ -10,9 +10,9 @@
 
 #include <cmath>
 
-#include "rfem/studies/quantities.hpp"
-#include "rfem/solvers/beam_theory.hpp"
-#include "rfem/solvers/modes.hpp"
+#include "../studies/quantities.hpp"
+#include "../solvers/beam_theory.hpp"
+#include "../solvers/modes.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

@@ -4,7 +4,7 @@
 
 #include <fstream>
 
-#include "rfem/cases/case_file.hpp"
+#include "../cases/case_file.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

@@ -7,9 +7,9 @@
 
 #include <random>
 
-#include "rfem/assembly/assemble.hpp"
-#include "rfem/solvers/chain_solver.hpp"
-#include "rfem/solvers/cholmod_solver.hpp"
+#include "../assembly/assemble.hpp"
+#include "../solvers/chain_solver.hpp"
+#include "../solvers/cholmod_solver.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

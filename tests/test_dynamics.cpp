@@ -8,10 +8,10 @@
 
 #include <filesystem>
 
-#include "rfem/assembly/dense_reference.hpp"
-#include "rfem/solvers/integrator.hpp"
-#include "rfem/solvers/newton_system.hpp"
-#include "rfem/solvers/reduction.hpp"
+#include "../assembly/dense_reference.hpp"
+#include "../solvers/integrator.hpp"
+#include "../solvers/newton_system.hpp"
+#include "../solvers/reduction.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

@@ -5,10 +5,10 @@
 // stops with a clear status before the yaw–pitch–roll angles become singular.
 #include <gtest/gtest.h>
 
-#include "rfem/studies/inputs.hpp"
-#include "rfem/assembly/dense_reference.hpp"
-#include "rfem/assembly/momentum.hpp"
-#include "rfem/solvers/integrator.hpp"
+#include "../studies/inputs.hpp"
+#include "../assembly/dense_reference.hpp"
+#include "../assembly/momentum.hpp"
+#include "../solvers/integrator.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

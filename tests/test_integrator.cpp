@@ -6,10 +6,10 @@
 
 #include <cmath>
 
-#include "rfem/assembly/workspace.hpp"
-#include "rfem/studies/inputs.hpp"
-#include "rfem/solvers/integrator.hpp"
-#include "rfem/solvers/thread_governor.hpp"
+#include "../assembly/workspace.hpp"
+#include "../studies/inputs.hpp"
+#include "../solvers/integrator.hpp"
+#include "../solvers/thread_governor.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

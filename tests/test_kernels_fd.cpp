@@ -8,12 +8,12 @@
 
 #include <functional>
 
-#include "rfem/assembly/assemble.hpp"
-#include "rfem/assembly/dense_reference.hpp"
-#include "rfem/core/positions.hpp"
-#include "rfem/core/rotation.hpp"
-#include "rfem/solvers/statics.hpp"
-#include "rfem/studies/linear_jacobian.hpp"
+#include "../assembly/assemble.hpp"
+#include "../assembly/dense_reference.hpp"
+#include "../core/positions.hpp"
+#include "../core/rotation.hpp"
+#include "../solvers/statics.hpp"
+#include "../studies/linear_jacobian.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

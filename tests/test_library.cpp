@@ -7,14 +7,14 @@
 #include <cmath>
 #include <filesystem>
 
-#include "rfem/assembly/assemble.hpp"
-#include "rfem/solvers/equations.hpp"
-#include "rfem/solvers/mass_solve.hpp"
-#include "rfem/solvers/statics.hpp"
-#include "rfem/results/reader.hpp"
-#include "rfem/studies/inputs.hpp"
-#include "rfem/studies/recorders.hpp"
-#include "rfem/studies/runs.hpp"
+#include "../assembly/assemble.hpp"
+#include "../solvers/equations.hpp"
+#include "../solvers/mass_solve.hpp"
+#include "../solvers/statics.hpp"
+#include "../results/reader.hpp"
+#include "../studies/inputs.hpp"
+#include "../studies/recorders.hpp"
+#include "../studies/runs.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

@@ -11,11 +11,11 @@
 #include <limits>
 #include <sstream>
 
-#include "rfem/studies/inputs.hpp"
-#include "rfem/assembly/momentum.hpp"
-#include "rfem/solvers/integrator.hpp"
-#include "rfem/solvers/modes.hpp"
-#include "rfem/solvers/statics.hpp"
+#include "../studies/inputs.hpp"
+#include "../assembly/momentum.hpp"
+#include "../solvers/integrator.hpp"
+#include "../solvers/modes.hpp"
+#include "../solvers/statics.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

@@ -2,7 +2,7 @@
 
 #include <random>
 
-#include "rfem/core/rotation.hpp"
+#include "../core/rotation.hpp"
 
 namespace rfem::test {
 

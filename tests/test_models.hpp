@@ -2,7 +2,7 @@
 // Small models shared by the tests.
 #include <string>
 
-#include "rfem/cases/case_file.hpp"
+#include "../cases/case_file.hpp"
 
 namespace rfem::test {
 

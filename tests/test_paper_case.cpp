@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "rfem/studies/inputs.hpp"
-#include "rfem/solvers/integrator.hpp"
+#include "../studies/inputs.hpp"
+#include "../solvers/integrator.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

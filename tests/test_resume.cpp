@@ -8,12 +8,12 @@
 #include <fstream>
 #include <iterator>
 
-#include "rfem/results/writer.hpp"
-#include "rfem/studies/inputs.hpp"
-#include "rfem/studies/quantities.hpp"
-#include "rfem/studies/recorders.hpp"
-#include "rfem/studies/resume.hpp"
-#include "rfem/studies/simulation.hpp"
+#include "../results/writer.hpp"
+#include "../studies/inputs.hpp"
+#include "../studies/quantities.hpp"
+#include "../studies/recorders.hpp"
+#include "../studies/resume.hpp"
+#include "../studies/simulation.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

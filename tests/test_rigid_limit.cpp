@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include "rfem/assembly/assemble.hpp"
-#include "rfem/core/rotation.hpp"
+#include "../assembly/assemble.hpp"
+#include "../core/rotation.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

@@ -11,11 +11,11 @@
 #include <fstream>
 #include <iterator>
 
-#include "rfem/core/positions.hpp"
-#include "rfem/results/reader.hpp"
-#include "rfem/studies/inputs.hpp"
-#include "rfem/studies/sensors.hpp"
-#include "rfem/studies/simulation.hpp"
+#include "../core/positions.hpp"
+#include "../results/reader.hpp"
+#include "../studies/inputs.hpp"
+#include "../studies/sensors.hpp"
+#include "../studies/simulation.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

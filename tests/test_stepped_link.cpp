@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "rfem/studies/quantities.hpp"
+#include "../studies/quantities.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

@@ -11,10 +11,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "rfem/studies/modes_study.hpp"
-#include "rfem/studies/runs.hpp"
-#include "rfem/studies/show.hpp"
-#include "rfem/studies/static_study.hpp"
+#include "../studies/modes_study.hpp"
+#include "../studies/runs.hpp"
+#include "../studies/show.hpp"
+#include "../studies/static_study.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;

@@ -55,7 +55,7 @@ class Simulation:
     n:           rfes in all links (None: the case's own)
     output:      an HDF5 results file written as it goes (the layout of `rfem run`, group "run")
     state:       start from an rfem.SimulationState (or a file saved from one) of the same model
-    threads:     kernel threads (0: all cores)
+    threads:     kernel threads (0: the run times one thread against all and keeps the faster, as rfem.run)
     keep_series: keep every series in memory for finish()'s Run
 
     time, t_end [s]; q, v: every coordinate and rate in the model's order (numpy), named by

@@ -14,8 +14,8 @@
 #include <filesystem>
 #include <string>
 
-#include "rfem/cases/case_file.hpp"
-#include "rfem/studies/inputs.hpp"
+#include "../../cases/case_file.hpp"
+#include "../../studies/inputs.hpp"
 
 namespace {
 void write(const std::string& path, const std::string& text) {
