@@ -15,6 +15,7 @@
 #include "../results/reader.hpp"
 #include "../studies/inputs.hpp"
 #include "../studies/sensors.hpp"
+#include "../studies/show.hpp"
 #include "../studies/simulation.hpp"
 #include "tests/test_models.hpp"
 
@@ -616,5 +617,16 @@ TEST(Simulation, AControllersFailureIsTyped) {
     ASSERT_EQ(r.status.kind, RunStatus::Kind::Failed);
     EXPECT_EQ(r.status.reason, seen[0].what());
     EXPECT_DOUBLE_EQ(r.t_reached, 0.05);  // (every row up to that sample kept)
+  }
+}
+
+// `rfem show` counts a reduced link's unknowns as the run has them: its reduction's (axial rows,
+// modes and the modal derivatives the reduction keeps), not a formula of its own (which said 47
+// for Kane's beam with 4 modes and 2 derivatives; the equations have 45).
+TEST(Simulation, ShowCountsTheUnknownsTheRunHas) {
+  for (const char* derivatives : {"link.derivatives=0", "link.derivatives=2"}) {
+    const Case cs = read_case(test::source_path("cases/kane_spinup.toml"), {"link.modes=4", derivatives});
+    Simulation sim(cs, one_thread());
+    EXPECT_EQ(show_model(cs).unknowns, sim.equations().unknowns()) << derivatives;
   }
 }
