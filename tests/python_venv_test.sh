@@ -53,4 +53,9 @@ print(f"venv: rfem {rfem.__version__} from {os.path.relpath(here, sys.prefix)}, 
       f"peak tip deflection {abs(u1).max():.4f} m")
 EOF
 "$venv_py" "$src/scripts/make_stubs.py" --check --from "$(dirname "$("$venv_py" -c 'import rfem, os; print(os.path.dirname(rfem.__file__))')")"
+# The package's console scripts: installed, and the same commands as the program's (a file it cannot
+# read: one line, exit 2).
+for c in rfem-plot rfem-animate rfem-bode; do [[ -x $work/venv/bin/$c ]] || { echo "FAIL: no $c in the venv"; exit 1; }; done
+set +e; msg=$("$work/venv/bin/rfem-bode" "$work/none.h5" --input hub --output hub/q 2>&1 >/dev/null); code=$?; set -e
+[[ $code == 2 && $msg == "rfem bode: error: "* && $(wc -l <<<"$msg") == 1 ]] || { echo "FAIL: rfem-bode on a missing file: exit $code: $msg"; exit 1; }
 echo "python_venv: ok ($((SECONDS - start)) s)"
