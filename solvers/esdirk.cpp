@@ -74,10 +74,9 @@ struct EsdirkStepper::Impl {
   size_t next_break = 0;
   long n_out = 0, k_out = 1, steps_this_output = 0, attempts_this_output = 0;
   bool started = false;
-  // Digital laws (TorqueLaw::sample_time > 0): their joints, the columns of their joints among the
-  // unknowns, the index of each one's next sample.
-  std::vector<int> sampled, sampled_col;
-  std::vector<long> next_sample;
+  // The sample-and-holds the steps stop at (solvers/stepper.hpp: Sampler): the digital laws
+  // (TorqueLaw::sample_time > 0), then a caller's (a controller in the loop).
+  std::vector<Sampler> samplers;
 
   Impl(EquationsOfMotion& e, const IntegratorOptions& opts)
       : eq(e), o(opts), T(load_tableau(opts.esdirk_table)), u(e.unknowns()), s(T.s), alpha(s, VecX::Zero(u)),
@@ -85,37 +84,47 @@ struct EsdirkStepper::Impl {
         n_out(output_count(opts)) {
     for (int j = 0; j < static_cast<int>(e.inputs().size()); ++j)
       if (const JointInput& in = e.inputs()[j]; !in.prescribed() && in.torque->sample_time() > 0) {
-        sampled.push_back(j);
-        sampled_col.push_back(e.base_col()[j]);
-        next_sample.push_back(0);
+        const int col = e.base_col()[j];
+        samplers.push_back({in.torque->sample_time(), 0, false, [this, j, col](double ts) {
+                              eq.inputs()[j].torque->sample(ts, q[col], v[col]);
+                              return true;
+                            }});
       }
   }
 
-  double sample_time_of(size_t i) const { return eq.inputs()[sampled[i]].torque->sample_time(); }
-  // The next sample of any digital law after t (t_end if none).
+  // The next sample of any sampler after t (t_end if none).
   double next_sample_time() const {
     double t_next = o.t_end;
-    for (size_t i = 0; i < sampled.size(); ++i) t_next = std::min(t_next, next_sample[i] * sample_time_of(i));
+    for (const Sampler& x : samplers) t_next = std::min(t_next, x.next * x.period);
     return t_next;
   }
-  // The digital laws whose sample falls on t sample the joint there; the accelerations and powers
-  // are then those of the new held values (the right limit).
-  void sample_due() {
-    bool changed = false;
-    for (size_t i = 0; i < sampled.size(); ++i) {
-      const double ts = sample_time_of(i);
-      while (next_sample[i] * ts <= t + 1e-12 * std::max(1.0, t)) {
-        if (std::abs(next_sample[i] * ts - t) <= 1e-12 * std::max(1.0, t)) {
-          eq.inputs()[sampled[i]].torque->sample(t, q[sampled_col[i]], v[sampled_col[i]]);
-          changed = true;
-        }
-        ++next_sample[i];
-      }
-    }
-    if (!changed) return;
+  void inputs_changed_here() {
     a = eq.accelerations(t, q.data(), v.data());
     P = eq.residual(t, q.data(), v.data(), a.data(), r.data());
     ++st.residual_evals;
+  }
+  // The samplers whose sample falls on t sample there (in order; one that sees the state sees the
+  // inputs the earlier ones set); the accelerations and powers are then those of the new held
+  // values (the right limit).
+  void sample_due() {
+    bool changed = false;
+    for (Sampler& x : samplers) {
+      while (x.next * x.period <= t + 1e-12 * std::max(1.0, t)) {
+        if (std::abs(x.next * x.period - t) <= 1e-12 * std::max(1.0, t)) {
+          if (changed && x.needs_state) {
+            inputs_changed_here();
+            changed = false;
+          }
+          try {
+            changed = x.sample(t) || changed;
+          } catch (const std::exception& e) {  // (the sampler's own words: no step failed)
+            throw SamplerFailure(e.what());
+          }
+        }
+        ++x.next;
+      }
+    }
+    if (changed) inputs_changed_here();
   }
 
   void weights(const VecX& qa, const VecX& va, const VecX* qb, const VecX* vb) {
@@ -473,6 +482,8 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
         if (!saved) return emit.failure();
       }
     }
+  } catch (const SamplerFailure& e) {
+    return RunStatus::failed(e.what());
   } catch (const std::exception& e) {
     return fail(e.what());
   }
@@ -504,9 +515,12 @@ void EsdirkStepper::inputs_changed() {
   RFEM_CHECK_ARGUMENT(m.started, "start() first");
   // The accelerations and powers at t from the new inputs (right limit): the next step's first
   // stage and the outputs' interpolation start from them.
-  m.a = m.eq.accelerations(m.t, m.q.data(), m.v.data());
-  m.P = m.eq.residual(m.t, m.q.data(), m.v.data(), m.a.data(), m.r.data());
-  ++m.st.residual_evals;
+  m.inputs_changed_here();
+}
+
+void EsdirkStepper::add_sampler(Sampler s) {
+  RFEM_CHECK_ARGUMENT(s.period > 0 && std::isfinite(s.period) && s.next >= 0 && s.sample, "a sampler needs a period and a function");
+  impl_->samplers.push_back(std::move(s));
 }
 
 double EsdirkStepper::time() const { return impl_->t; }

@@ -21,6 +21,7 @@ class EsdirkStepper final : public Stepper {
   RunStatus start(SampleEmitter& emit) override;
   RunStatus advance(double until, SampleEmitter& emit) override;
   void inputs_changed() override;
+  void add_sampler(Sampler s) override;
   double time() const override;
   double t_reached() const override;
   const IntegratorStats& stats() const override;

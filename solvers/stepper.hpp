@@ -4,11 +4,33 @@
 // inverse dynamics at the outputs (solvers/integrator.cpp). A run is start() then advance(t_end); a
 // caller that steps calls advance(t) as often as it likes, each call ending exactly at t, the
 // outputs on the run's grid (output_time) delivered to the emitter as the steps pass them.
+#include <functional>
 #include <memory>
+#include <stdexcept>
 
 #include "integrator.hpp"
 
 namespace rfem {
+
+/// A sample-and-hold the steps stop at: a digital law (TorqueLaw::sample_time, its joint's value
+/// held between samples) or a caller's controller in the loop (studies/control_loop.cpp) — one
+/// mechanism for both. sample(t) is called at t = k·period (k = next, next + 1, …) once the steps
+/// reach t, after the outputs there; it returns whether it changed the inputs (the accelerations
+/// and powers there are then evaluated again: the next step starts from the right limit). What it
+/// throws ends the run failed with its words.
+struct Sampler {
+  double period = 0.0;  ///< [s]
+  long next = 0;        ///< the next k
+  /// It reads the state (a snapshot): inputs changed by earlier samplers at t are in force first.
+  bool needs_state = false;
+  std::function<bool(double t)> sample;
+};
+
+/// What a sampler threw, carried through the stepper unchanged (not a step's failure).
+class SamplerFailure : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 class Stepper {
  public:
@@ -23,6 +45,11 @@ class Stepper {
   /// The inputs changed at the current time (a held torque, a new reference): the accelerations and
   /// powers there are evaluated again, so the next step starts from the right limit.
   virtual void inputs_changed() = 0;
+  /// Adds a sampler after the digital laws' (std::logic_error where the steps do not stop at
+  /// samples: BDF, inverse dynamics).
+  virtual void add_sampler(Sampler) {
+    throw std::logic_error("sample-and-hold needs simulation.integrator = \"esdirk\" (its steps end at the samples)");
+  }
   virtual double time() const = 0;       ///< where the last step ended [s]
   virtual double t_reached() const = 0;  ///< the last output delivered [s]
   virtual const IntegratorStats& stats() const = 0;

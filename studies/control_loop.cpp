@@ -1,8 +1,10 @@
-// A digital controller in the loop (studies/simulation.hpp: run_controlled): a loop over a
-// Simulation's advance(), the controller's output held from its sample (zero-order hold) and
-// recorded in the run's group (run/control).
+// A digital controller in the loop (studies/simulation.hpp: run_controlled): the controller is the
+// simulation's sample-and-hold (Simulation::sample_every: the stepper stops at its samples as at a
+// digital law's), its output held from its sample (zero-order hold) and recorded in the run's group
+// (run/control).
 #include <cmath>
 #include <deque>
+#include <optional>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -30,6 +32,8 @@ RunResult run_controlled(const Case& cs, SimulationOptions opts, const Controlle
     throw std::invalid_argument(fmt::format("delay = {} samples ({:.6g} s) is not shorter than the run ({:.6g} s from t = {:.6g} s): "
                                             "the controller would never act",
                                             c.delay, c.delay * c.sample_time, t_end - t0, t0));
+  if (cs.sim.options.kind != IntegratorKind::Esdirk)
+    throw CaseError(cs.path + ": simulation.integrator: a controller in the loop needs \"esdirk\" (its steps end at the samples)");
   Simulation sim(cs, std::move(opts));
   const Model& md = sim.model();
   const std::vector<std::string> kinds = sim.joint_inputs();
@@ -51,18 +55,13 @@ RunResult run_controlled(const Case& cs, SimulationOptions opts, const Controlle
     return sim.finish(s);
   };
   std::deque<ControlOutput> pending;
-  // The samples t_k = k·sample_time from the start's time on (a state's time between two samples: to
-  // the next one under the state's held values first).
-  long k0 = static_cast<long>(std::ceil(t0 / c.sample_time * (1 - 1e-12)));
-  if (k0 * c.sample_time > t0 && sim.status().kind == RunStatus::Kind::Running)
-    sim.advance(std::min(k0 * c.sample_time, t_end));
-  std::string last;  // the last output that took effect, for a run that fails after it
-  for (long k = k0;; ++k) {
-    const double tk = k * c.sample_time;
-    if (tk >= t_end * (1 - 1e-12) || sim.status().kind != RunStatus::Kind::Running) break;
-    ControlOutput u;
+  std::string last;                       // the last output that took effect, for a run that fails after it
+  std::optional<ControllerError> failure;  // the controller's, ending the run
+  // One sample: the controller sees the snapshot at t_k; its output takes effect `delay` samples
+  // later and is held (the simulation's held values) until the next one does.
+  const auto at_sample = [&](double tk) {
     try {
-      u = controller(tk, sim.snapshot());
+      ControlOutput u = controller(tk, sim.snapshot());
       const auto refused = [&](const std::string& why) {
         return ControllerError(ControllerError::Kind::NotFinite, tk, fmt::format("controller: {} at t = {:.6g} s", why, tk));
       };
@@ -88,23 +87,39 @@ RunResult run_controlled(const Case& cs, SimulationOptions opts, const Controlle
       }
     } catch (const std::exception& e) {
       const auto* typed = dynamic_cast<const ControllerError*>(&e);
-      const ControllerError err = typed ? *typed
-                                        : ControllerError(ControllerError::Kind::Threw, tk,
-                                                          fmt::format("controller: {} at t = {:.6g} s", e.what(), tk));
+      failure = typed ? *typed
+                      : ControllerError(ControllerError::Kind::Threw, tk, fmt::format("controller: {} at t = {:.6g} s", e.what(), tk));
       if (c.on_error) {
         try {
-          c.on_error(err);
+          c.on_error(*failure);
         } catch (...) {  // (the caller's channel: the run's record says why in any case)
         }
       }
-      return finish(RunStatus::failed(err.what()));
+      throw *failure;  // (ends the run with these words)
     }
     record.data.push_back(tk);
     record.data.insert(record.data.end(), now.begin(), now.end());
     ++record.rows;
-    const RunStatus st = sim.advance(std::min((k + 1) * c.sample_time, t_end));
+  };
+  // The samples t_k = k·sample_time from the start's time on: one at the start is taken here, the
+  // later ones where the steps reach them (Simulation::sample_every: the stepper's sample-and-hold,
+  // as a digital law's); a state's time between two samples goes to the next one under the state's
+  // held values first.
+  const long k0 = static_cast<long>(std::ceil(t0 / c.sample_time * (1 - 1e-12)));
+  long first = k0;
+  if (!(k0 * c.sample_time > t0) && k0 * c.sample_time < t_end * (1 - 1e-12) && sim.status().kind == RunStatus::Kind::Running) {
+    try {
+      at_sample(k0 * c.sample_time);
+    } catch (const ControllerError& e) {
+      return finish(RunStatus::failed(e.what()));
+    }
+    first = k0 + 1;
+  }
+  if (sim.status().kind == RunStatus::Kind::Running) {
+    sim.sample_every(c.sample_time, first, at_sample);
+    const RunStatus st = sim.advance(t_end);
     // A run that fails under the controller's output says which output it was under.
-    if (st.kind == RunStatus::Kind::Failed && !last.empty())
+    if (st.kind == RunStatus::Kind::Failed && !failure && !last.empty())
       return finish(RunStatus::failed(st.reason + " (under the controller's output of " + last + ")"));
   }
   return finish(std::nullopt);

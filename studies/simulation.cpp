@@ -456,6 +456,27 @@ RunStatus Simulation::advance(double t) {
   return m.status;
 }
 
+void Simulation::sample_every(double period, long first, std::function<void(double t)> f) {
+  Impl& m = *impl_;
+  m.require_running("sample_every");
+  RFEM_CHECK_ARGUMENT(period > 0 && std::isfinite(period) && first >= 0 && f, "sample_every: a positive period, a first sample and a function");
+  RFEM_CHECK_ARGUMENT(m.stepper != nullptr, "sample_every: the run failed at its start");
+  Sampler x;
+  x.period = period;
+  x.next = first;  // (one at or before now is skipped: a sample at now is the caller's)
+  x.needs_state = true;
+  const double last = m.o.t_end * (1 - 1e-12);  // (none at t_end: nothing is left to hold)
+  x.sample = [&m, f = std::move(f), last](double t) {
+    if (t >= last) return false;
+    m.changed = false;  // (every earlier change is in force: the stepper brought it up to date)
+    f(t);
+    const bool changed = m.changed;
+    m.changed = false;  // (the stepper evaluates the new inputs now)
+    return changed;
+  };
+  m.stepper->add_sampler(std::move(x));
+}
+
 Snapshot Simulation::snapshot() {
   Impl& m = *impl_;
   m.require_running("snapshot");

@@ -116,6 +116,13 @@ class Simulation {
   /// Back to the case's own law for that joint.
   void release(const std::string& joint);
 
+  /// A sample-and-hold in the loop: f(t) is called at t = k·period for k = first, first + 1, … with
+  /// time() < t < t_end() as the steps reach it (they end there, as at a digital law's samples: one mechanism,
+  /// solvers/stepper.hpp), after the outputs there. f sees the simulation as a caller between two
+  /// advance() calls does (snapshot, set_torque, set_reference, release; not advance); what it
+  /// holds stays until it changes it. What f throws ends the run failed with its words (every row
+  /// before kept). std::logic_error for BDF (its steps do not end at samples).
+  void sample_every(double period, long first, std::function<void(double t)> f);
   /// Integrates to t (time() ≤ t ≤ t_end()), the last step ending exactly at t, every output of the
   /// case's grid on the way recorded. Running while t < t_end, Completed at t_end; after Failed or
   /// Interrupted it stays there (finish() records it).

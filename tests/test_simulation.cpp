@@ -630,3 +630,29 @@ TEST(Simulation, ShowCountsTheUnknownsTheRunHas) {
     EXPECT_EQ(show_model(cs).unknowns, sim.equations().unknowns()) << derivatives;
   }
 }
+
+// A controller in the loop is the stepper's sample-and-hold, as a digital law is: f runs at every
+// k·period with the simulation standing exactly there; BDF's steps do not stop at samples, so it is
+// refused in one line naming the key.
+TEST(Simulation, AControllerIsTheSteppersSampleAndHold) {
+  const Case cs = hub(0.1);
+  Simulation sim(cs, one_thread());
+  std::vector<double> at;
+  sim.sample_every(0.025, 1, [&](double t) {
+    EXPECT_EQ(sim.time(), t);
+    at.push_back(t);
+    sim.set_torque("hub", 220.0);
+  });
+  ASSERT_EQ(sim.advance(0.1).kind, RunStatus::Kind::Completed);
+  EXPECT_EQ(at, (std::vector<double>{0.025, 0.05, 0.07500000000000001}));  // (none at t_end)
+  Case bdf = cs;
+  bdf.sim.options.kind = IntegratorKind::Bdf;
+  try {
+    run_controlled(bdf, one_thread(), [](double, const Snapshot&) { return ControlOutput{}; }, ControlOptions{0.01, 0, {}});
+    FAIL() << "BDF accepted";
+  } catch (const CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("simulation.integrator"), std::string::npos) << e.what();
+  }
+  Simulation stepped(bdf, one_thread());
+  EXPECT_THROW(stepped.sample_every(0.01, 1, [](double) {}), std::logic_error);
+}
