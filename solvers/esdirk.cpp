@@ -77,6 +77,9 @@ struct EsdirkStepper::Impl {
   // The sample-and-holds the steps stop at (solvers/stepper.hpp: Sampler): the digital laws
   // (TorqueLaw::sample_time > 0), then a caller's (a controller in the loop).
   std::vector<Sampler> samplers;
+  // Wall time spent in samplers that see the state (a caller's controller): not the step's, so
+  // the thread governor does not count it (solvers/thread_governor.hpp).
+  std::chrono::steady_clock::duration in_samplers{};
 
   Impl(EquationsOfMotion& e, const IntegratorOptions& opts)
       : eq(e), o(opts), T(load_tableau(opts.esdirk_table)), u(e.unknowns()), s(T.s), alpha(s, VecX::Zero(u)),
@@ -115,11 +118,13 @@ struct EsdirkStepper::Impl {
             inputs_changed_here();
             changed = false;
           }
+          const auto start = std::chrono::steady_clock::now();
           try {
             changed = x.sample(t) || changed;
           } catch (const std::exception& e) {  // (the sampler's own words: no step failed)
             throw SamplerFailure(e.what());
           }
+          if (x.needs_state) in_samplers += std::chrono::steady_clock::now() - start;
         }
         ++x.next;
       }
@@ -292,10 +297,13 @@ RunStatus EsdirkStepper::Impl::advance(double until, SampleEmitter& emit) {
         std::chrono::steady_clock::time_point start;
         const long& now;
         long before;
+        const std::chrono::steady_clock::duration& outside;  // (a controller's time: not the step's)
+        std::chrono::steady_clock::duration outside_before;
         ~StepTimer() {
-          eq.report_step(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), now - before);
+          const auto spent = std::chrono::steady_clock::now() - start - (outside - outside_before);
+          eq.report_step(std::chrono::duration<double>(spent).count(), now - before);
         }
-      } timer{eq, step_start, st.residual_evals, residuals_before};
+      } timer{eq, step_start, st.residual_evals, residuals_before, in_samplers, in_samplers};
       if (eq.stop_requested()) return RunStatus::interrupted(eq.stop().signal());
       if (!emit.beat(t, st.steps)) return emit.failure();
       if (steps_this_output > o.max_steps)
