@@ -19,6 +19,29 @@ namespace rfem::pyargs {
 
 namespace py = pybind11;
 
+/// A type's text for the stubs (a template argument: Typed<"int | None">).
+template <size_t N>
+struct TypeText {
+  char text[N];
+  constexpr TypeText(const char (&t)[N]) {  // NOLINT: implicit, as a literal
+    for (size_t i = 0; i < N; ++i) text[i] = t[i];
+  }
+};
+
+/// An argument the binding checks itself (the functions below: one-line TypeError/ValueError naming
+/// it), declared with the Python type its stub shows: pybind11 hands it over as the object it is.
+template <TypeText T>
+struct Typed {
+  py::handle object;
+  operator py::handle() const { return object; }  // NOLINT: implicit, to the checks below
+  bool is_none() const { return object.is_none(); }
+  PyObject* ptr() const { return object.ptr(); }
+  template <typename U>
+  U cast() const {
+    return object.cast<U>();
+  }
+};
+
 inline std::string type_name(py::handle v) { return py::str(py::type::of(v).attr("__name__")).cast<std::string>(); }
 inline std::string shown(py::handle v) { return py::repr(v).cast<std::string>(); }
 
@@ -190,3 +213,15 @@ class CaseArg {
 };
 
 }  // namespace rfem::pyargs
+
+namespace pybind11::detail {
+template <rfem::pyargs::TypeText T>
+struct type_caster<rfem::pyargs::Typed<T>> {
+  PYBIND11_TYPE_CASTER(rfem::pyargs::Typed<T>, const_name(T.text));
+  bool load(handle src, bool) {
+    value.object = src;
+    return static_cast<bool>(src);
+  }
+  static handle cast(const rfem::pyargs::Typed<T>& v, return_value_policy, handle) { return v.object.inc_ref(); }
+};
+}  // namespace pybind11::detail

@@ -154,7 +154,7 @@ PYBIND11_MODULE(_rfem, m) {
   });
 
   py::class_<RunStatus>(m, "RunStatus", "How a run ended, parsed from its status text (RunStatus.parse(run.status)).")
-      .def_static("parse", [](py::handle text) { return RunStatus::parse(args::text(text, "text")); }, py::arg("text"),
+      .def_static("parse", [](args::Typed<"str"> text) { return RunStatus::parse(args::text(text, "text")); }, py::arg("text"),
                   "'running', 'completed', 'interrupted (signal N)', 'failed: why'; other text is a failure with it as reason")
       .def_property_readonly("kind", [](const RunStatus& s) {
         switch (s.kind) {
@@ -166,23 +166,23 @@ PYBIND11_MODULE(_rfem, m) {
         return "failed";
       }, "running, completed, interrupted or failed")
       .def_property_readonly("completed", &RunStatus::is_completed)
-      .def_readonly("signal", &RunStatus::signal, "interrupted: the signal that asked for the stop (0: a caller's stop)")
-      .def_readonly("reason", &RunStatus::reason, "failed: why")
+      .def_readonly("signal", &RunStatus::signal, "int: interrupted, the signal that asked for the stop (0: a caller's stop)")
+      .def_readonly("reason", &RunStatus::reason, "str: failed, why")
       .def("__str__", &RunStatus::to_string)
       .def("__repr__", [](const RunStatus& s) { return "<rfem.RunStatus " + s.to_string() + ">"; })
       .def(py::pickle([](const RunStatus& s) { return s.to_string(); }, [](const std::string& t) { return RunStatus::parse(t); }));
 
   py::class_<Case>(m, "Case", "A case: a TOML case file as read and checked (rfem.load, rfem.Case.from_text).")
-      .def_static("load", [](py::handle path, py::handle overrides) {
+      .def_static("load", [](args::Typed<"Union[str, os.PathLike]"> path, args::Typed<"List[str]"> overrides) {
         return read_case(args::path(path, "path"), args::texts(overrides, "overrides"));
       }, py::arg("path"), py::arg("overrides") = py::tuple(),
          "Reads and checks a case file; overrides are 'key.path=value' strings (as rfem --set).")
-      .def_static("from_text", [](py::handle text, py::handle name, py::handle overrides, py::handle base_dir) {
+      .def_static("from_text", [](args::Typed<"str"> text, args::Typed<"str"> name, args::Typed<"List[str]"> overrides, args::Typed<"Optional[Union[str, os.PathLike]]"> base_dir) {
         return parse_case(args::text(text, "text"), args::text(name, "name"), args::texts(overrides, "overrides"),
                           args::path(base_dir, "base_dir", true));
       }, py::arg("text"), py::arg("name") = "<text>", py::arg("overrides") = py::tuple(), py::arg("base_dir") = "",
          "A case from TOML text; `name` stands for the file in messages, table files are found in base_dir.")
-      .def("with_overrides", [](const Case& c, py::handle overrides) { return with_overrides(c, args::texts(overrides, "overrides")); },
+      .def("with_overrides", [](const Case& c, args::Typed<"List[str]"> overrides) { return with_overrides(c, args::texts(overrides, "overrides")); },
            py::arg("overrides"), "The case with more 'key.path=value' overrides, read and checked again (CaseError names the key).")
       .def_readonly("path", &Case::path)
       .def_readonly("text", &Case::text, "the case file as read")
@@ -214,7 +214,7 @@ PYBIND11_MODULE(_rfem, m) {
   py::class_<Model, std::shared_ptr<Model>>(m, "Model", "A case's model: its links cut into rfes, its joints.")
       .def_property_readonly("n", &Model::n, "rfes of all links")
       .def_property_readonly("m", &Model::m, "joints")
-      .def_property_readonly("dof", &Model::dof, "coordinates: 6 per rfe, one per joint")
+      .def_property_readonly("dof", &Model::dof, "int: coordinates, 6 per rfe and one per joint")
       .def_readonly("free_base", &Model::free_base)
       .def_readonly("gravity", &Model::gravity)
       .def_property_readonly("links", [](const Model& md) {
@@ -232,7 +232,7 @@ PYBIND11_MODULE(_rfem, m) {
         return "<rfem.Model n=" + std::to_string(md.n()) + " rfes, m=" + std::to_string(md.m()) + " joints>";
       })
       .def(py::pickle(&pyorigin::model_state, &pyorigin::model_from));
-  m.def("model", [](py::handle c, py::handle n_arg) {
+  m.def("model", [](args::Typed<"Union[Case, str, os.PathLike]"> c, args::Typed<"Optional[int]"> n_arg) {
     const args::CaseArg cs(c);
     const int n = args::rfes(n_arg);
     const auto md = model_of(*cs, n);
@@ -253,7 +253,7 @@ PYBIND11_MODULE(_rfem, m) {
         py::dict d;
         for (const auto& p : r.peaks) d[py::str(p.name)] = py::dict(py::arg("u1") = p.u1, py::arg("u2") = p.u2, py::arg("theta") = p.theta);
         return d;
-      }, "per link: peak |u1|, |u2| [m], |theta| [rad]")
+      }, "dict: per link, peak |u1|, |u2| [m], |theta| [rad]")
       .def_readonly("energy_drift", &RunResult::energy_drift, "max |balance(t) - balance(0)| [J]")
       .def_readonly("warnings", &RunResult::warnings, "where the solution left the small deformation the model assumes")
       .def_readonly("energy_scale", &RunResult::energy_scale, "[J]")
@@ -261,13 +261,13 @@ PYBIND11_MODULE(_rfem, m) {
       .def_property_readonly("names", [](const RunResult& r) {
         return r.series ? r.series->names() : std::vector<std::string>{};
       }, "the series kept (empty if the run kept none)")
-      .def("table", [](const std::shared_ptr<RunResult>& r, py::handle series) {
+      .def("table", [](const std::shared_ptr<RunResult>& r, args::Typed<"str"> series) {
         const std::string name = args::text(series, "name");
         if (!r->series) throw py::value_error("the run kept no series (keep_series=False)");
         const RunSeries::View v = r->series->view(name);
         return view(std::shared_ptr<const RunSeries>(r->series), v.data, v.rows, v.info->width());
       }, py::arg("name"), "Series `name` (rows = outputs) as a read-only array, e.g. 'joint_tau', 'links/upper/tip_deflection'.")
-      .def("column", [](const std::shared_ptr<RunResult>& r, py::handle series, py::handle column) {
+      .def("column", [](const std::shared_ptr<RunResult>& r, args::Typed<"str"> series, args::Typed<"Union[str, int]"> column) {
         const std::string name = args::text(series, "name");
         if (!r->series) throw py::value_error("the run kept no series (keep_series=False)");
         const RunSeries::View v = r->series->view(name);
@@ -296,7 +296,7 @@ PYBIND11_MODULE(_rfem, m) {
         return a;
       }, py::arg("name"), py::arg("column"),
          "One column of a series as a read-only 1-D array (a row per output): by its name in the file ('u1') or its number.")
-      .def("info", [](const RunResult& r, py::handle series) {
+      .def("info", [](const RunResult& r, args::Typed<"str"> series) {
         const std::string name = args::text(series, "name");
         if (!r.series) throw py::value_error("the run kept no series (keep_series=False)");
         const SeriesInfo& i = *r.series->view(name).info;
@@ -315,8 +315,8 @@ PYBIND11_MODULE(_rfem, m) {
       })
       .def(py::pickle(&pyorigin::run_state, &pyorigin::run_from));
 
-  m.def("_run", [](py::handle case_arg, py::handle n_arg, py::handle output_arg, py::handle runs, py::handle threads,
-                   py::handle keep_series, py::handle progress, py::handle checkpoint) {
+  m.def("_run", [](args::Typed<"Union[Case, str, os.PathLike]"> case_arg, args::Typed<"Optional[int]"> n_arg, args::Typed<"Optional[Union[str, os.PathLike]]"> output_arg, args::Typed<"Optional[List[str]]"> runs, args::Typed<"int"> threads,
+                   args::Typed<"bool"> keep_series, args::Typed<"Optional[Callable[[dict], Any]]"> progress, args::Typed<"float"> checkpoint) {
     const args::CaseArg cs_arg(case_arg);
     const Case& cs = *cs_arg;
     const int n = args::rfes(n_arg);
@@ -343,7 +343,7 @@ PYBIND11_MODULE(_rfem, m) {
 
   m.attr("CHECKPOINT_INTERVAL") = kCheckpointInterval;
 
-  m.def("_resume", [](py::handle path_arg, py::handle threads, py::handle keep_series, py::handle progress, py::handle checkpoint) {
+  m.def("_resume", [](args::Typed<"Union[str, os.PathLike]"> path_arg, args::Typed<"int"> threads, args::Typed<"bool"> keep_series, args::Typed<"Optional[Callable[[dict], Any]]"> progress, args::Typed<"float"> checkpoint) {
     const std::string path = args::path(path_arg, "resume");
     auto pending = std::make_shared<CallGuard>();
     std::vector<std::string> warnings;
@@ -365,7 +365,7 @@ PYBIND11_MODULE(_rfem, m) {
     return py::make_tuple(out, error, warnings, done);
   }, py::arg("path"), py::arg("threads"), py::arg("keep_series"), py::arg("progress"), py::arg("checkpoint"));
 
-  m.def("write_xdmf", [](py::handle results_arg, py::handle runs_arg) {
+  m.def("write_xdmf", [](args::Typed<"Union[str, os.PathLike]"> results_arg, args::Typed<"Optional[List[str]]"> runs_arg) {
     const std::string results = args::path(results_arg, "results");
     const std::vector<std::string> runs = args::texts(runs_arg, "runs");
     py::gil_scoped_release release;
@@ -374,7 +374,7 @@ PYBIND11_MODULE(_rfem, m) {
      "ParaView (XDMF 2) files beside a results file for every run (or `runs`) that stored its poses "
      "(simulation.store_flexible_every > 0); returns the paths written. rfem view RESULTS.h5 does the same.");
 
-  m.def("_show", [](py::handle cs, py::handle n) {
+  m.def("_show", [](args::Typed<"Union[Case, str, os.PathLike]"> cs, args::Typed<"Optional[int]"> n) {
     const ModelSummary s = show_model(*args::CaseArg(cs), args::rfes(n));
     py::list entries;
     for (const TreeEntry& e : s.entries)
@@ -403,13 +403,13 @@ PYBIND11_MODULE(_rfem, m) {
           d[py::str(t.name)] = py::dict(py::arg("n") = t.n, py::arg("displacement") = vector_array(t.motion.head<3>()),
                                         py::arg("rotation") = vector_array(t.motion.tail<3>()));
         return d;
-      }, "per link: its free end's displacement [m] and rotation [rad] in its {r}")
+      }, "dict: per link, its free end's displacement [m] and rotation [rad] in its {r}")
       .def_property_readonly("model", [](const StaticStudy& s) { return std::const_pointer_cast<Model>(s.model); })
       .def("__repr__", [](const StaticStudy& s) {
         return "<rfem.StaticResult n=" + std::to_string(s.model->n()) + " rfes, " + std::to_string(s.solution.iterations) +
                " iterations, residual " + py::repr(py::float_(s.solution.residual)).cast<std::string>() + " N>";
       });
-  m.def("_static", [](py::handle case_arg, py::handle n_arg, py::handle rate, py::handle joint) {
+  m.def("_static", [](args::Typed<"Union[Case, str, os.PathLike]"> case_arg, args::Typed<"Optional[int]"> n_arg, args::Typed<"Optional[float]"> rate, args::Typed<"int"> joint) {
     const args::CaseArg cs(case_arg);
     const int n = args::rfes(n_arg);
     const JointRate r = joint_rate(rate, joint);
@@ -446,7 +446,7 @@ PYBIND11_MODULE(_rfem, m) {
           out.append(py::dict(py::arg("hz") = r.reference_hz, py::arg("theory") = r.theory, py::arg("relative_error") = r.relative_error,
                               py::arg("euler_bernoulli_hz") = r.euler_bernoulli_hz ? py::cast(*r.euler_bernoulli_hz) : py::none()));
         return out;
-      }, "per mode, for one uniform segment: the exact value it converges to")
+      }, "Optional[list]: per mode, for one uniform segment, the exact value it converges to (None: no reference)")
       .def_readonly("warnings", &ModesStudy::warnings)
       .def_property_readonly("model", [](const ModesStudy& s) { return std::const_pointer_cast<Model>(s.model); })
       .def("__repr__", [](const ModesStudy& s) {
@@ -457,8 +457,8 @@ PYBIND11_MODULE(_rfem, m) {
         return "<rfem.ModesResult " + std::to_string(s.modes.omega.size()) + " modes, n=" + std::to_string(s.model->n()) +
                " rfes: " + f + " Hz>";
       });
-  m.def("_modes", [](py::handle case_arg, py::handle n, py::handle count, py::handle free, py::handle rate, py::handle joint,
-                     py::handle output_arg) {
+  m.def("_modes", [](args::Typed<"Union[Case, str, os.PathLike]"> case_arg, args::Typed<"Optional[int]"> n, args::Typed<"int"> count, args::Typed<"Optional[List[Union[str, int]]]"> free, args::Typed<"Optional[float]"> rate, args::Typed<"int"> joint,
+                     args::Typed<"Optional[Union[str, os.PathLike]]"> output_arg) {
     const args::CaseArg cs_arg(case_arg);
     const Case& cs = *cs_arg;
     ModesRequest rq;
@@ -474,9 +474,9 @@ PYBIND11_MODULE(_rfem, m) {
     return s;
   }, py::arg("case"), py::arg("n"), py::arg("count"), py::arg("free"), py::arg("rate"), py::arg("joint"), py::arg("output"));
 
-  m.def("_refine", [](py::handle case_arg, py::handle ns, py::handle quantity_args, py::handle output_arg,
-                      py::handle integration_check, py::handle rate, py::handle joint, py::handle threads, py::handle progress,
-                      py::handle modes) {
+  m.def("_refine", [](args::Typed<"Union[Case, str, os.PathLike]"> case_arg, args::Typed<"List[int]"> ns, args::Typed<"List[str]"> quantity_args, args::Typed<"Optional[Union[str, os.PathLike]]"> output_arg,
+                      args::Typed<"bool"> integration_check, args::Typed<"Optional[float]"> rate, args::Typed<"int"> joint, args::Typed<"int"> threads, args::Typed<"Optional[Callable[[dict], Any]]"> progress,
+                      args::Typed<"Optional[List[int]]"> modes) {
     const args::CaseArg cs_arg(case_arg);
     const Case& cs = *cs_arg;
     const std::vector<std::string> quantities = args::texts(quantity_args, "quantities");

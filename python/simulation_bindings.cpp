@@ -128,9 +128,9 @@ void bind_simulation(py::module_& m) {
                                                  std::to_string(x.ndim()) + "-D");
         return SimulationState::unpack(model, std::vector<double>(x.data(), x.data() + x.size()));
       }, py::arg("model"), py::arg("packed"))
-      .def("save", [](const SimulationState& s, py::handle path) { save_state(s, args::path(path, "path")); }, py::arg("path"),
+      .def("save", [](const SimulationState& s, args::Typed<"Union[str, os.PathLike]"> path) { save_state(s, args::path(path, "path")); }, py::arg("path"),
            "into an HDF5 file of its own (state/packed, state/model)")
-      .def_static("load", [](py::handle path) { return load_state(args::path(path, "path")); }, py::arg("path"))
+      .def_static("load", [](args::Typed<"Union[str, os.PathLike]"> path) { return load_state(args::path(path, "path")); }, py::arg("path"))
       .def(py::pickle([](const SimulationState& s) { return py::make_tuple(s.model, s.pack()); },
                       [](const py::tuple& t) {
                         if (t.size() != 2 || !PyUnicode_Check(t[0].ptr()))
@@ -167,8 +167,14 @@ void bind_simulation(py::module_& m) {
     Simulation* operator->() const { return p.sim.get(); }
     Simulation& operator*() const { return *p.sim; }
   };
+  // (declared before the simulation that returns it: the signatures name it)
+  py::class_<LinearModel, std::shared_ptr<LinearModel>> linear_model(
+      m, "LinearModel",
+      "A linear model about a state (rfem.linearize, Simulation.linearize): M q'' + D q' + K q = B u, "
+      "y = Cq q + Cv q' + Ca q'' (deviations from the operating point; SI units, rows and columns named by "
+      "states, inputs, outputs); state_space() gives A, B, C, D of x = (q, q').");
   py::class_<PySimulation>(m, "_Simulation")
-      .def(py::init([](py::handle case_arg, py::handle n, py::handle threads, py::handle output, py::handle keep_series,
+      .def(py::init([](args::Typed<"Union[Case, str, os.PathLike]"> case_arg, args::Typed<"Optional[int]"> n, args::Typed<"int"> threads, args::Typed<"Optional[Union[str, os.PathLike]]"> output, args::Typed<"bool"> keep_series,
                        std::optional<SimulationState> state, const std::string& made_by) {
              const args::CaseArg cs(case_arg);
              auto p = std::make_unique<PySimulation>();
@@ -191,14 +197,14 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("status", [](const PySimulation& p) { return Use(p, "status")->status().to_string(); })
       .def_property_readonly("finished", [](const PySimulation& p) { return Use(p, "finished")->finished(); })
       .def_property_readonly("output", [](const PySimulation& p) { return Use(p, "output")->output(); })
-      .def("set_torque", [](PySimulation& p, py::handle j, py::handle tau) {
+      .def("set_torque", [](PySimulation& p, args::Typed<"str"> j, args::Typed<"float"> tau) {
         Use(p, "set_torque")->set_torque(args::text(j, "joint"), args::real(tau, "tau", "a finite torque [N m] or force [N]"));
       })
-      .def("set_reference", [](PySimulation& p, py::handle j, py::handle q, py::handle v, py::handle ff) {
+      .def("set_reference", [](PySimulation& p, args::Typed<"str"> j, args::Typed<"float"> q, args::Typed<"float"> v, args::Typed<"float"> ff) {
         Use(p, "set_reference")->set_reference(args::text(j, "joint"), args::real(q, "q"), args::real(v, "qd"), args::real(ff, "tau_ff"));
       })
-      .def("release", [](PySimulation& p, py::handle j) { Use(p, "release")->release(args::text(j, "joint")); })
-      .def("advance", [](PySimulation& p, py::handle time) {
+      .def("release", [](PySimulation& p, args::Typed<"str"> j) { Use(p, "release")->release(args::text(j, "joint")); })
+      .def("advance", [](PySimulation& p, args::Typed<"float"> time) {
         const double t = args::real(time, "t", "a finite time [s]");
         RunStatus s;
         {
@@ -214,12 +220,12 @@ void bind_simulation(py::module_& m) {
         return snapshot_dict(use->snapshot(), use->model());
       })
       .def("state", [](const PySimulation& p) { return Use(p, "state")->state(); })
-      .def("linearize", [](PySimulation& p, py::handle equilibrium, py::handle dense) {
+      .def("linearize", [](PySimulation& p, args::Typed<"bool"> equilibrium, args::Typed<"bool"> dense) {
         const bool eq = args::flag(equilibrium, "equilibrium"), d = args::flag(dense, "dense");
         const Use use(p, "linearize");
         py::gil_scoped_release release;
         return std::make_shared<LinearModel>(linearize(*use, eq, d));
-      })
+      }, py::arg("equilibrium"), py::arg("dense"))
       .def("finish", [](PySimulation& p) {
         std::shared_ptr<RunResult> r;
         {
@@ -230,15 +236,11 @@ void bind_simulation(py::module_& m) {
         return r;
       });
 
-  py::class_<LinearModel, std::shared_ptr<LinearModel>>(
-      m, "LinearModel",
-      "A linear model about a state (rfem.linearize, Simulation.linearize): M q'' + D q' + K q = B u, "
-      "y = Cq q + Cv q' + Ca q'' (deviations from the operating point; SI units, rows and columns named by "
-      "states, inputs, outputs); state_space() gives A, B, C, D of x = (q, q').")
+  linear_model
       .def_readonly("t", &LinearModel::t, "the state's time [s]")
       .def_readonly("equilibrium", &LinearModel::equilibrium, "about rest (q'' = 0) or the motion")
-      .def_readonly("states", &LinearModel::states, "the unknowns: rfe coordinates LINK/rfeK/x1 … phi3, free joints")
-      .def_readonly("inputs", &LinearModel::inputs, "free joints: a torque [N m] (force [N]) added to each")
+      .def_readonly("states", &LinearModel::states, "List[str]: the unknowns, rfe coordinates LINK/rfeK/x1 … phi3, free joints")
+      .def_readonly("inputs", &LinearModel::inputs, "List[str]: free joints, a torque [N m] (force [N]) added to each")
       .def_readonly("outputs", &LinearModel::outputs, "LINK/tip_u1 … tip_theta, JOINT/q, v, tau, sensor columns")
       .def_readonly("output_units", &LinearModel::output_units)
       .def_property_readonly("M", [](const LinearModel& l) { return l.M; }, "states × states [kg, kg m, kg m²] (scipy.sparse CSC)")
@@ -246,9 +248,9 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("K", [](const LinearModel& l) { return l.K; }, "states × states: elastic, geometric, gravity, centrifugal, PD kp (sparse)")
       .def_property_readonly("B", [](const LinearModel& l) { return l.B; }, "states × inputs (sparse)")
       .def_readonly("evaluations", &LinearModel::evaluations, "evaluations of the equations it took")
-      .def_property_readonly("Cq", [](const LinearModel& l) { return l.Cq; }, "outputs × states")
-      .def_property_readonly("Cv", [](const LinearModel& l) { return l.Cv; }, "outputs × states")
-      .def_property_readonly("Ca", [](const LinearModel& l) { return l.Ca; }, "outputs × states")
+      .def_property_readonly("Cq", [](const LinearModel& l) { return l.Cq; }, "outputs × states (dense)")
+      .def_property_readonly("Cv", [](const LinearModel& l) { return l.Cv; }, "outputs × states (dense)")
+      .def_property_readonly("Ca", [](const LinearModel& l) { return l.Ca; }, "outputs × states (dense)")
       .def_property_readonly("q0", [](const LinearModel& l) { return array(l.q0); }, "the operating point (states)")
       .def_property_readonly("v0", [](const LinearModel& l) { return array(l.v0); })
       .def_property_readonly("a0", [](const LinearModel& l) { return array(l.a0); })
@@ -294,8 +296,8 @@ void bind_simulation(py::module_& m) {
     py::gil_scoped_release release;
     return linear_modes(l, count);
   }, py::arg("M"), py::arg("D"), py::arg("K"), py::arg("count"));
-  m.def("_linearize", [](py::handle case_arg, py::handle n, py::handle state, py::handle threads, py::handle equilibrium,
-                         py::handle output_arg, const std::string& made_by, py::handle dense) {
+  m.def("_linearize", [](args::Typed<"Union[Case, str, os.PathLike]"> case_arg, args::Typed<"Optional[int]"> n, args::Typed<"Optional[SimulationState]"> state, args::Typed<"int"> threads, args::Typed<"bool"> equilibrium,
+                         args::Typed<"Optional[Union[str, os.PathLike]]"> output_arg, const std::string& made_by, args::Typed<"bool"> dense) {
     const args::CaseArg cs_arg(case_arg);
     const Case& cs = *cs_arg;
     LinearizeRequest rq;
@@ -312,9 +314,9 @@ void bind_simulation(py::module_& m) {
     return std::make_shared<LinearModel>(linearize_into_file(cs, rq, output, made_by));
   }, py::arg("case"), py::arg("n"), py::arg("state"), py::arg("threads"), py::arg("equilibrium"), py::arg("output"), py::arg("made_by"), py::arg("dense"));
 
-  m.def("_run_controlled", [](py::handle case_arg, py::handle n, py::handle threads, py::handle output, py::handle keep_series,
+  m.def("_run_controlled", [](args::Typed<"Union[Case, str, os.PathLike]"> case_arg, args::Typed<"Optional[int]"> n, args::Typed<"int"> threads, args::Typed<"Optional[Union[str, os.PathLike]]"> output, args::Typed<"bool"> keep_series,
                               std::optional<SimulationState> state, const std::string& made_by, py::object controller,
-                              py::handle sample_time, py::handle delay) {
+                              args::Typed<"float"> sample_time, args::Typed<"int"> delay) {
     const args::CaseArg cs_arg(case_arg);
     const Case& cs = *cs_arg;
     if (!PyCallable_Check(controller.ptr())) args::type_error("controller", "callable f(t, y)", controller);

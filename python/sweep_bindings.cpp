@@ -96,10 +96,10 @@ void bind_sweep(py::module_& m) {
       })
       .def(py::pickle(&pyorigin::sweep_state, &pyorigin::sweep_from));
 
-  m.def("load_sweep", [](py::handle path, py::handle output) {
+  m.def("load_sweep", [](args::Typed<"Union[str, os.PathLike]"> path, args::Typed<"Optional[Union[str, os.PathLike]]"> output) {
     return read_sweep(args::path(path, "path"), args::path(output, "output", true));
   }, py::arg("path"), py::arg("output") = "", "Reads a sweep file and checks every point (CaseError as rfem sweep prints it).");
-  m.def("run_point", [](py::handle sweep, py::handle k_arg, py::handle threads_arg) {
+  m.def("run_point", [](args::Typed<"Sweep"> sweep, args::Typed<"int"> k_arg, args::Typed<"int"> threads_arg) {
     const Sweep& s = sweep_of(sweep);
     const int k = point(s, k_arg);
     const int threads = args::threads(threads_arg);
@@ -111,12 +111,12 @@ void bind_sweep(py::module_& m) {
     return row_dict(r);
   }, py::arg("sweep"), py::arg("k"), py::arg("threads") = 1,
      "Runs point k into its file; returns its row {status, wall_s, t_reached, steps, residual_evals, values}.");
-  m.def("finished_point", [](py::handle sweep, py::handle k) -> py::object {
+  m.def("finished_point", [](args::Typed<"Sweep"> sweep, args::Typed<"int"> k) -> py::object {
     const Sweep& s = sweep_of(sweep);
     const auto r = finished_point(s, point(s, k));
     return r ? py::object(row_dict(*r)) : py::none();
   }, py::arg("sweep"), py::arg("k"), "Point k's row if its file holds a finished run of it, else None.");
-  m.def("write_index", [](py::handle sweep, py::handle rows) {
+  m.def("write_index", [](args::Typed<"Sweep"> sweep, args::Typed<"List[dict]"> rows) {
     const Sweep& s = sweep_of(sweep);
     if (PyUnicode_Check(rows.ptr()) || !py::isinstance<py::iterable>(rows)) args::type_error("rows", "a list of dicts (run_point's rows)", rows);
     std::vector<SweepRow> rs;
@@ -125,7 +125,7 @@ void bind_sweep(py::module_& m) {
     write_index(s, rs);
   }, py::arg("sweep"), py::arg("rows"), "Writes the index from one row per point (dicts as run_point returns).");
 
-  m.def("_sweep", [](py::handle sweep, py::handle jobs, py::handle retry_failed, py::handle progress_arg) {
+  m.def("_sweep", [](args::Typed<"Sweep"> sweep, args::Typed<"int"> jobs, args::Typed<"bool"> retry_failed, args::Typed<"Optional[Callable[[dict], Any]]"> progress_arg) {
     const Sweep& s = sweep_of(sweep);
     const py::object progress = args::callback(progress_arg, "progress");
     SweepRequest rq;
