@@ -292,7 +292,7 @@ RunStatus BdfStepper::advance(double until, SampleEmitter& emit) {
   RFEM_CHECK_ARGUMENT(until >= t_ && until <= o_.t_end, "until must lie in [t, t_end]");
   p_.emit = &emit;
   const int u = u_;
-  for (; k_ <= n_out_ && output_time(o_, k_) <= until; ++k_) {
+  while (k_ <= n_out_ && output_time(o_, k_) <= until) {
     double tret = 0.0;
     if (RunStatus s = solve_to(output_time(o_, k_), tret); s.kind != RunStatus::Kind::Running) return s;
     const double* y = N_VGetArrayPointer(h_.y);
@@ -314,11 +314,8 @@ RunStatus BdfStepper::advance(double until, SampleEmitter& emit) {
     t_ = t_reached_ = tret;
     // A checkpoint at the output: IDA's state there with the accelerations and powers of the
     // equations (its interpolated y' is first order), and the next step it would take.
-    const long k = k_;
-    ++k_;  // (the state's next output)
-    const bool saved = emit.checkpoint([&] { return state(); });
-    k_ = k;
-    if (!saved) return emit.failure();
+    ++k_;  // (the next output: the state's)
+    if (!emit.checkpoint([&] { return state(); })) return emit.failure();
   }
   if (t_ < until) {  // the caller's stop between two outputs: IDA's stop time there
     check(IDASetStopTime(h_.ida, until), "IDASetStopTime");

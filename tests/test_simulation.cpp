@@ -1,8 +1,8 @@
 // A simulation a caller steps (studies/simulation.hpp): one advance to the end is `rfem run` bit for
 // bit; chunks agree with one run to the integrator's accuracy; a simulation started from a saved
 // state continues the original bit for bit; a held torque equal to the case's law changes nothing;
-// a digital PD controller converges to the continuous PD law at first order in its sample time;
-// the energy books balance with a controller in the loop; bad arguments are refused with one line.
+// the energy books balance with a held torque; bad arguments are refused with one line; IDA steps
+// too; a procedure's run is the integrator's. Controllers in the loop: tests/test_control_loop.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,93 +17,11 @@
 #include "../studies/sensors.hpp"
 #include "../studies/show.hpp"
 #include "../studies/simulation.hpp"
+#include "tests/simulation_cases.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;
-
-namespace {
-
-// Kane's beam on a torque-driven hub (220 N m against drive damping and friction), 6 rfes.
-Case hub(double t_end) {
-  return read_case(test::source_path("cases/kane_hub_drive.toml"),
-                   {"simulation.t_end=" + std::to_string(t_end), "link.n=6", "simulation.output_dt=0.01"});
-}
-
-// Kane's aluminium and section (cases/kane_beam.toml).
-constexpr const char* kKaneMaterial = R"(
-[materials.kane]
-E = 7.0e10
-G = 2.6923076923e10
-rho = 3000.0
-[sections.kane]
-A = 4.0e-4
-Iy = 2.0e-7
-Iz = 2.0e-7
-J = 4.0e-7
-)";
-
-// The same beam on a PD-controlled hub following Kane's spin-up to 2 rad/s in 1 s (no feed-forward).
-Case pd_hub() {
-  return parse_case(std::string(kKaneMaterial) + R"(
-[[joints]]
-name = "hub"
-drive = { inertia = 50.0 }
-input = { kind = "pd", reference = { kind = "spinup", Omega = 2.0, T = 1.0 }, kp = 4000.0, kd = 800.0 }
-[link]
-n = 4
-[[link.segments]]
-length = 10.0
-material = "kane"
-section = "kane"
-[simulation]
-t_end = 1.5
-output_dt = 0.01
-)",
-                    "pd_hub.toml");
-}
-
-// pd_hub()'s PD law (kp = 4000, kd = 800 on the spin-up) written as a controller.
-Controller pd_hub_controller() {
-  const auto reference = spinup_law(0.0, 2.0, 1.0);
-  return [reference](double t, const Snapshot& y) {
-    const MotionSample r = reference->at(t);
-    ControlOutput u;
-    u.torques["hub"] = 4000.0 * (r.q - y.joint_q[0]) + 800.0 * (r.qd - y.joint_v[0]);
-    return u;
-  };
-}
-
-SimulationOptions one_thread() {
-  SimulationOptions o;
-  o.threads = 1;
-  o.keep_series = true;
-  return o;
-}
-
-Table series(const RunResult& r, const std::string& name) { return r.series->table(name); }
-
-double max_abs(const Table& t) {
-  double m = 0.0;
-  for (double x : t.data) m = std::max(m, std::abs(x));
-  return m;
-}
-
-// max |a − b| over b's rows, each against a's row of the same time (b's rows at times a does not
-// have are skipped: a state's own row); at least `matched` rows must be compared.
-double max_difference(const Table& a, const Table& ta, const Table& b, const Table& tb, long matched = -1) {
-  double d = 0.0;
-  long i = 0, m = 0;
-  for (long j = 0; j < b.rows; ++j) {
-    while (i < a.rows && ta.at(i, 0) < tb.at(j, 0) - 1e-12) ++i;
-    if (i == a.rows || std::abs(ta.at(i, 0) - tb.at(j, 0)) > 1e-12) continue;
-    for (long c = 0; c < a.cols; ++c) d = std::max(d, std::abs(a.at(i, c) - b.at(j, c)));
-    ++m;
-  }
-  EXPECT_GE(m, matched < 0 ? b.rows : matched) << "rows compared";
-  return d;
-}
-
-}  // namespace
+using namespace rfem::test;
 
 TEST(Simulation, OneAdvanceToTheEndIsTheRunBitForBit) {
   const Case cs = hub(0.5);
@@ -213,33 +131,6 @@ TEST(Simulation, AHeldTorqueEqualToTheCaseLawChangesNothing) {
   d.advance(0.3);
   const int hub_q = d.model().joint_index(0);
   EXPECT_GT(d.q()[hub_q], qa[hub_q]);
-}
-
-TEST(Simulation, DigitalPdConvergesToTheContinuousLawAtFirstOrder) {
-  // A controller computing the case's PD law from the sampled joint, held for a sample: the error
-  // against the continuous law is the zero-order hold's, O(Ts).
-  const Case cs = pd_hub();
-  RunRequest rq;
-  rq.threads = 1;
-  const RunResult continuous = run_case(cs, rq).at(0);
-  const Controller pd = pd_hub_controller();
-  std::vector<double> errors;
-  for (double ts : {4e-3, 2e-3, 1e-3}) {
-    ControlOptions c;
-    c.sample_time = ts;
-    const RunResult r = run_controlled(cs, one_thread(), pd, c);
-    ASSERT_TRUE(r.completed()) << r.status;
-    const Table a = series(continuous, "joint_q"), b = series(r, "joint_q");
-    errors.push_back(max_difference(a, series(continuous, "time"), b, series(r, "time")));
-    // The books balance with the controller in the loop: the input work of the held torques is
-    // integrated exactly over steps that end at the samples.
-    EXPECT_LT(r.energy_drift, 1e-6 * r.energy_scale) << "Ts = " << ts;
-  }
-  for (size_t i = 1; i < errors.size(); ++i) {
-    const double order = std::log2(errors[i - 1] / errors[i]);
-    RecordProperty("order_" + std::to_string(i), std::to_string(order));
-    EXPECT_NEAR(order, 1.0, 0.15) << "errors " << errors[i - 1] << " -> " << errors[i];
-  }
 }
 
 TEST(Simulation, BadArgumentsAreRefusedWithOneLine) {
@@ -395,39 +286,6 @@ output_dt = 0.01
   EXPECT_NEAR(r.sensors.at(0, 1), exact, 1e-4 * exact);
 }
 
-TEST(Simulation, TheBuiltInDigitalPdIsTheSameLawAsAControllerBitForBit) {
-  // `pd` with sample_time: the case's law sampled and held by the integrator itself; the same law
-  // written as a controller at the same rate takes the same steps on the same values; a stepped
-  // simulation of the case samples it too (chunks end steps elsewhere: to the tolerances).
-  const Case continuous = pd_hub();
-  const Case digital = with_overrides(continuous, {"joints.0.input.sample_time=2e-3"});
-  RunRequest rq;
-  rq.threads = 1;
-  const RunResult builtin = run_case(digital, rq).at(0);
-  ASSERT_TRUE(builtin.completed()) << builtin.status;
-  const Controller pd = pd_hub_controller();
-  ControlOptions c;
-  c.sample_time = 2e-3;
-  const RunResult loop = run_controlled(with_overrides(continuous, {"joints.0.input={kind=\"torque\", value=0.0}", "joints.0.drive={inertia=50.0}"}),
-                                        one_thread(), pd, c);
-  ASSERT_TRUE(loop.completed()) << loop.status;
-  EXPECT_EQ(builtin.stats.steps, loop.stats.steps);
-  EXPECT_EQ(series(builtin, "joint_q").data, series(loop, "joint_q").data);
-  EXPECT_EQ(series(builtin, "tip_deflection").data, series(loop, "tip_deflection").data);
-  // A simulation of the digital case, stepped in chunks that are not samples, samples the same.
-  Simulation sim(digital, one_thread());
-  for (double t = 0.37; t < sim.t_end(); t += 0.37) sim.advance(t);
-  sim.advance(sim.t_end());
-  const RunResult stepped = sim.finish();
-  // (to the integrator's relative tolerance; a law that did not sample leaves the hub at rest)
-  const double q_end = series(builtin, "joint_q").data.back();
-  EXPECT_NEAR(series(stepped, "joint_q").data.back(), q_end, 1e-6 * std::abs(q_end));
-  // A delay of one sample is another law (later by Ts), and a sample time with BDF is refused.
-  const RunResult late = run_case(with_overrides(digital, {"joints.0.input.delay=1"}), rq).at(0);
-  EXPECT_NE(series(late, "joint_q").data, series(builtin, "joint_q").data);
-  EXPECT_THROW(run_case(with_overrides(digital, {"simulation.integrator=\"bdf\""}), rq), CaseError);
-}
-
 TEST(Simulation, ACaseStartsFromASavedStateAsTheProgramRunsIt) {
   // [simulation] state = "FILE": rfem run (run_case, run_into_file) goes on from the saved state,
   // the same bits as the simulation it was saved from; another model's state is refused by key.
@@ -507,49 +365,6 @@ TEST(Simulation, NoisySensorsGoOnBitForBitFromAStateOnAndOffTheGrid) {
   }
 }
 
-// A closed loop that feeds energy in (positive feedback on the hub's rate) ends as diverged within
-// its first simulated second, not "completed" after hundreds of thousands of steps.
-TEST(Simulation, ADivergingLoopEndsDivergedWithItsRowsKept) {
-  const Case cs = hub(1.0);
-  const RunResult r = run_controlled(cs, one_thread(), [](double, const Snapshot& y) {
-    ControlOutput u;
-    u.torques["hub"] = 1e5 * y.joint_v[0] + 1e3;
-    return u;
-  }, ControlOptions{0.01, 0, {}});
-  ASSERT_EQ(r.status.kind, RunStatus::Kind::Failed) << r.status;
-  EXPECT_EQ(r.status.reason.rfind("diverged at t = ", 0), 0u) << r.status;
-  EXPECT_LT(r.t_reached, 1.0);
-  EXPECT_LT(r.stats.steps, 50000);
-  EXPECT_GT(r.samples, 1);
-  EXPECT_EQ(series(r, "time").rows, r.samples);
-}
-
-// A controller started from a state later than its first sample time samples from the state's time on.
-TEST(Simulation, AControllerStartsFromAStatesTime) {
-  const Case cs = hub(0.3);
-  Simulation s(cs, one_thread());
-  s.advance(0.105);
-  SimulationOptions o = one_thread();
-  o.state = std::make_shared<const SimulationState>(s.state());
-  std::vector<double> called;
-  const RunResult r = run_controlled(cs, o, [&](double t, const Snapshot& y) {
-    EXPECT_EQ(t, y.t);
-    called.push_back(t);
-    ControlOutput u;
-    u.torques["hub"] = 200.0;
-    return u;
-  }, ControlOptions{0.01, 0, {}});
-  ASSERT_TRUE(r.completed()) << r.status;
-  ASSERT_FALSE(called.empty());
-  EXPECT_NEAR(called.front(), 0.11, 1e-12);  // the first sample after the state's time
-  EXPECT_NEAR(called.back(), 0.29, 1e-12);
-  // Bad sample times and delays are refused before the run.
-  EXPECT_THROW(run_controlled(cs, one_thread(), [](double, const Snapshot&) { return ControlOutput{}; }, ControlOptions{1e-300, 0, {}}),
-               std::invalid_argument);
-  EXPECT_THROW(run_controlled(cs, one_thread(), [](double, const Snapshot&) { return ControlOutput{}; }, ControlOptions{0.01, 1000000, {}}),
-               std::invalid_argument);
-}
-
 // IDA's BDF behind the same engine: stepped in 10 ms chunks (each one IDA's stop time) and started
 // again from a state taken mid-run (IDA restarts there), it agrees with one BDF run to the
 // integrator's accuracy (README "Performance": integration error below 1e-4 of the peaks; two such
@@ -596,30 +411,6 @@ TEST(Simulation, AProcedureRunIsTheIntegratorsRunBitForBit) {
   EXPECT_EQ(tips, series(run, "tip_deflection").data);
 }
 
-// A controller's failure reaches its caller typed (ControllerError), not as text to match: a value
-// that is not finite is refused by the loop (NotFinite), an exception is the controller's (Threw);
-// either way the run ends failed with the same words at that sample.
-TEST(Simulation, AControllersFailureIsTyped) {
-  const Case cs = hub(0.2);
-  for (const bool throws : {false, true}) {
-    std::vector<ControllerError> seen;
-    ControlOptions c{0.01, 0, {}};
-    c.on_error = [&](const ControllerError& e) { seen.push_back(e); };
-    const RunResult r = run_controlled(cs, one_thread(), [throws](double t, const Snapshot&) {
-      ControlOutput u;
-      if (t > 0.045 && throws) throw std::runtime_error("sensor lost");
-      u.torques["hub"] = t > 0.045 ? NAN : 220.0;
-      return u;
-    }, c);
-    ASSERT_EQ(seen.size(), 1u);
-    EXPECT_EQ(seen[0].kind(), throws ? ControllerError::Kind::Threw : ControllerError::Kind::NotFinite);
-    EXPECT_DOUBLE_EQ(seen[0].t(), 0.05);
-    ASSERT_EQ(r.status.kind, RunStatus::Kind::Failed);
-    EXPECT_EQ(r.status.reason, seen[0].what());
-    EXPECT_DOUBLE_EQ(r.t_reached, 0.05);  // (every row up to that sample kept)
-  }
-}
-
 // `rfem show` counts a reduced link's unknowns as the run has them: its reduction's (axial rows,
 // modes and the modal derivatives the reduction keeps), not a formula of its own (which said 47
 // for Kane's beam with 4 modes and 2 derivatives; the equations have 45).
@@ -629,30 +420,4 @@ TEST(Simulation, ShowCountsTheUnknownsTheRunHas) {
     Simulation sim(cs, one_thread());
     EXPECT_EQ(show_model(cs).unknowns, sim.equations().unknowns()) << derivatives;
   }
-}
-
-// A controller in the loop is the stepper's sample-and-hold, as a digital law is: f runs at every
-// k·period with the simulation standing exactly there; BDF's steps do not stop at samples, so it is
-// refused in one line naming the key.
-TEST(Simulation, AControllerIsTheSteppersSampleAndHold) {
-  const Case cs = hub(0.1);
-  Simulation sim(cs, one_thread());
-  std::vector<double> at;
-  sim.sample_every(0.025, 1, [&](double t) {
-    EXPECT_EQ(sim.time(), t);
-    at.push_back(t);
-    sim.set_torque("hub", 220.0);
-  });
-  ASSERT_EQ(sim.advance(0.1).kind, RunStatus::Kind::Completed);
-  EXPECT_EQ(at, (std::vector<double>{0.025, 0.05, 0.07500000000000001}));  // (none at t_end)
-  Case bdf = cs;
-  bdf.sim.options.kind = IntegratorKind::Bdf;
-  try {
-    run_controlled(bdf, one_thread(), [](double, const Snapshot&) { return ControlOutput{}; }, ControlOptions{0.01, 0, {}});
-    FAIL() << "BDF accepted";
-  } catch (const CaseError& e) {
-    EXPECT_NE(std::string(e.what()).find("simulation.integrator"), std::string::npos) << e.what();
-  }
-  Simulation stepped(bdf, one_thread());
-  EXPECT_THROW(stepped.sample_every(0.01, 1, [](double) {}), std::logic_error);
 }
