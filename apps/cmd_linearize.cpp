@@ -5,10 +5,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "commands.hpp"
 #include "../results/errors.hpp"
-#include "../studies/recorders.hpp"
+#include "../simulation/recorders.hpp"
 #include "../studies/run_file.hpp"
+#include "commands.hpp"
 
 namespace rfem::app {
 

@@ -5,13 +5,13 @@
 #include <cmath>
 #include <memory>
 
+#include "../simulation/inputs.hpp"
+#include "../simulation/recorders.hpp"
+#include "../studies/refine.hpp"
+#include "../studies/run_file.hpp"
 #include "commands.hpp"
 #include "progress.hpp"
 #include "signals.hpp"
-#include "../studies/inputs.hpp"
-#include "../studies/recorders.hpp"
-#include "../studies/refine.hpp"
-#include "../studies/run_file.hpp"
 
 namespace rfem::app {
 

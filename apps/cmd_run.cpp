@@ -2,13 +2,13 @@
 #include <fmt/core.h>
 #include <spdlog/spdlog.h>
 
+#include "../simulation/inputs.hpp"
+#include "../simulation/recorders.hpp"
+#include "../studies/resume.hpp"
+#include "../studies/run_file.hpp"
 #include "commands.hpp"
 #include "progress.hpp"
 #include "signals.hpp"
-#include "../studies/inputs.hpp"
-#include "../studies/recorders.hpp"
-#include "../studies/resume.hpp"
-#include "../studies/run_file.hpp"
 
 namespace rfem::app {
 

@@ -9,8 +9,8 @@
 
 #include "../cases/case_file.hpp"
 #include "../results/writer.hpp"
+#include "../simulation/common.hpp"
 #include "../solvers/inputs.hpp"
-#include "../studies/common.hpp"
 #include "../studies/runs.hpp"
 #include "../studies/sweep.hpp"
 

@@ -9,8 +9,8 @@
 #include <cstdlib>
 #include <string>
 
+#include "../simulation/simulation.hpp"
 #include "../solvers/inputs.hpp"
-#include "../studies/simulation.hpp"
 
 int main(int argc, char** argv) {
   if (argc < 5) {

@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "names.hpp"
-#include "sensor_spec.hpp"
 #include "../core/model.hpp"
 #include "../solvers/integrator.hpp"
 #include "../solvers/statics.hpp"
+#include "names.hpp"
+#include "sensor_spec.hpp"
 
 namespace rfem {
 
@@ -54,7 +54,7 @@ struct SimulationSettings {
   IntegratorOptions options;
   Procedure procedure = Procedure::Single;  ///< single, or paper (rigid inverse dynamics, kinematic, force input)
   int flexible_every = 0;            ///< store the full flexible state every k outputs (0: never)
-  /// Start from a saved simulation state (studies/simulation.hpp: save_state), resolved against the
+  /// Start from a saved simulation state (simulation/state.hpp: save_state), resolved against the
   /// case's folder; "" for the case's own initial state.
   std::string state;
 };

@@ -25,7 +25,7 @@ std::vector<SensorSpec> read_sensors(const Reader& r, const toml::table& root, c
   if (!sn) return out;
   const toml::array* arr = sn->as_array();
   if (!arr) r.fail(sn, "sensors", "must be an array of tables ([[sensors]])");
-  // Names the snapshot a controller sees already uses (studies/simulation.hpp, Snapshot).
+  // Names the snapshot a controller sees already uses (simulation/simulation.hpp, Snapshot).
   const std::set<std::string> reserved = {"t", "q", "qd", "tau", "tip_position", "tip_deflection", "time"};
   std::set<std::string> names;
   for (size_t i = 0; i < arr->size(); ++i) {

@@ -1,6 +1,6 @@
 #pragma once
 // A sensor named in a case ([[sensors]], docs/case_files.md): what a lab would measure, for
-// controllers (studies/simulation.hpp) and as recorded outputs (studies/sensors.hpp evaluates them).
+// controllers (simulation/simulation.hpp) and as recorded outputs (simulation/sensors.hpp evaluates them).
 #include <string>
 
 namespace rfem {

@@ -17,7 +17,7 @@ namespace rfem {
 enum class JointType { Revolute, Prismatic };
 
 /// What a joint is rated for (a URDF's <limit>): rfem does not enforce them — a run warns where
-/// its solution leaves them (studies/validity.hpp). Infinite: none.
+/// its solution leaves them (simulation/validity.hpp). Infinite: none.
 struct JointLimits {
   double lower = -std::numeric_limits<double>::infinity();  ///< [rad or m]
   double upper = std::numeric_limits<double>::infinity();

@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "../studies/common.hpp"
+#include "../simulation/common.hpp"
 #include "rfem/version.hpp"
 
 namespace rfem::pyorigin {

@@ -16,21 +16,21 @@
 #include <csignal>
 #include <memory>
 
-#include "arguments.hpp"
-#include "call_guard.hpp"
-#include "pickling.hpp"
 #include "../cases/case_file.hpp"
-#include "../results/xdmf.hpp"
 #include "../results/errors.hpp"
-#include "../studies/inputs.hpp"
+#include "../results/xdmf.hpp"
+#include "../simulation/inputs.hpp"
+#include "../simulation/recorders.hpp"
 #include "../studies/modes_study.hpp"
-#include "../studies/recorders.hpp"
-#include "../studies/resume.hpp"
 #include "../studies/refine.hpp"
+#include "../studies/resume.hpp"
 #include "../studies/run_file.hpp"
 #include "../studies/runs.hpp"
 #include "../studies/show.hpp"
 #include "../studies/static_study.hpp"
+#include "arguments.hpp"
+#include "call_guard.hpp"
+#include "pickling.hpp"
 #include "rfem/version.hpp"
 
 namespace py = pybind11;

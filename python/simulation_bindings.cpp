@@ -16,10 +16,11 @@
 #include <pybind11/eigen.h>
 
 #include "../results/writer.hpp"
-#include "../studies/inputs.hpp"
-#include "../studies/recorders.hpp"
+#include "../simulation/inputs.hpp"
+#include "../simulation/recorders.hpp"
+#include "../simulation/simulation.hpp"
+#include "../studies/resume.hpp"
 #include "../studies/run_file.hpp"
-#include "../studies/simulation.hpp"
 
 namespace py = pybind11;
 using namespace rfem;
@@ -130,7 +131,8 @@ void bind_simulation(py::module_& m) {
       }, py::arg("model"), py::arg("packed"))
       .def("save", [](const SimulationState& s, args::Typed<"Union[str, os.PathLike]"> path) { save_state(s, args::path(path, "path")); }, py::arg("path"),
            "into an HDF5 file of its own (state/packed, state/model)")
-      .def_static("load", [](args::Typed<"Union[str, os.PathLike]"> path) { return load_state(args::path(path, "path")); }, py::arg("path"))
+      .def_static("load", [](args::Typed<"Union[str, os.PathLike]"> path) { return read_state(args::path(path, "path")); }, py::arg("path"),
+                  "a state file (save) or a single run's results file: its newest checkpoint (an interrupted or killed run's)")
       .def(py::pickle([](const SimulationState& s) { return py::make_tuple(s.model, s.pack()); },
                       [](const py::tuple& t) {
                         if (t.size() != 2 || !PyUnicode_Check(t[0].ptr()))

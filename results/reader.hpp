@@ -54,7 +54,7 @@ class ResultsReader {
 };
 
 /// A run's last checkpoint in its group (dataset `checkpoint`): the output rows and flexible rows it
-/// covers and the state to resume from (studies/checkpoints.hpp packs it). Two slots written in
+/// covers and the state to resume from (simulation/state.hpp packs it). Two slots written in
 /// turn, each with a checksum, so a run killed while writing one still has the other.
 struct Checkpoint {
   long rows = 0, flexible_rows = 0;

@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
+#include "../solvers/integrator.hpp"
+#include "../solvers/refinement.hpp"
 #include "errors.hpp"
 #include "layout.hpp"
 #include "reader.hpp"
-#include "../solvers/integrator.hpp"
-#include "../solvers/refinement.hpp"
 
 namespace rfem {
 
@@ -110,7 +110,7 @@ class RunWriter {
   /// The sensors' row of the output just appended (time first; RunDescription::sensor_columns).
   void append_sensors(const std::vector<double>& row);
   /// Records a checkpoint covering every row appended so far (flushed first), in the older slot.
-  /// The state comes in pieces (studies/checkpoints.hpp), written one after the other: no copy of it.
+  /// The state comes in pieces (simulation/state.hpp), written one after the other: no copy of it.
   void checkpoint(const std::vector<std::span<const double>>& pieces);
   /// Writes the status, the integrator's statistics, the wall time and any warnings about the
   /// solution (attribute `warnings`, one per line), and leaves SWMR mode.

@@ -91,10 +91,12 @@ bool SampleEmitter::checkpoint_due() const {
 
 bool SampleEmitter::checkpoint(const std::function<IntegratorState()>& st) {
   if (failed()) return false;
-  return checkpoint_due() ? checkpoint(st()) : true;
+  if (!checkpoint_due()) return true;
+  IntegratorState x = st();
+  return checkpoint(x);
 }
 
-bool SampleEmitter::checkpoint(const IntegratorState& st) {
+bool SampleEmitter::checkpoint(IntegratorState& st) {
   if (failed()) return false;
   if (!control_.checkpoint) return true;
   try {

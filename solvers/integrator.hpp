@@ -89,7 +89,7 @@ using SampleSink = std::function<void(const OutputSample&)>;
 /// Everything the ESDIRK integrator carries from one step to the next, taken after an accepted step
 /// whose outputs have been delivered: resuming from it continues the run as if it had never stopped
 /// (bit for bit with the same thread team). BDF's is its state at an output (IDA's history is not
-/// kept). Written into results files as a checkpoint (studies/checkpoints.hpp).
+/// kept). Written into results files as a checkpoint (simulation/state.hpp).
 struct IntegratorState {
   double t = 0.0, h = 0.0;        ///< time reached [s], next step size [s]
   double err_prev = 1.0, eta = 1.0;  ///< step controller's last error, Newton's contraction estimate
@@ -117,7 +117,7 @@ struct RunControl {
   /// Called on the calling thread with the integrator's state after an accepted step (BDF: after an
   /// output) at most every `checkpoint_interval` seconds of wall time (0: never). If it throws, the
   /// run fails with its message.
-  std::function<void(const IntegratorState&)> checkpoint;
+  std::function<void(IntegratorState&)> checkpoint;  // (it may borrow the vectors; they are back on return)
   double checkpoint_interval = 0.0;  ///< [s]
   /// Start from this state instead of t = 0 (the outputs before state.next_output are not delivered
   /// again): ESDIRK goes on bit for bit, BDF restarts IDA there (the same solution within the
@@ -172,7 +172,7 @@ class SampleEmitter {
   /// Whether a checkpoint is due (its interval has passed, nothing failed).
   bool checkpoint_due() const;
   /// Hands `st` to the caller's checkpoint now. False if it threw.
-  bool checkpoint(const IntegratorState& st);
+  bool checkpoint(IntegratorState& st);
   const IntegratorState* resume() const { return control_.resume; }
   bool failed() const { return !error_.empty(); }
   /// The status of a run ended by the sink or heartbeat.

@@ -1,5 +1,5 @@
 #pragma once
-// One interface for everything that advances a run in time (studies/simulation.hpp drives it):
+// One interface for everything that advances a run in time (simulation/simulation.hpp drives it):
 // ESDIRK (solvers/esdirk.cpp), IDA's BDF (solvers/bdf.cpp) and, for a model without unknowns,
 // inverse dynamics at the outputs (solvers/integrator.cpp). A run is start() then advance(t_end); a
 // caller that steps calls advance(t) as often as it likes, each call ending exactly at t, the

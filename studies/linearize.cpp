@@ -15,11 +15,11 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "../core/positions.hpp"
 #include "../results/reader.hpp"
 #include "../results/writer.hpp"
-#include "../core/positions.hpp"
-#include "sensors.hpp"
-#include "simulation.hpp"
+#include "../simulation/sensors.hpp"
+#include "../simulation/simulation.hpp"
 
 namespace rfem {
 

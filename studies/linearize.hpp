@@ -17,10 +17,10 @@
 #include <vector>
 
 #include "../core/model.hpp"
+#include "../simulation/simulation.hpp"
 #include "../solvers/equations.hpp"
 #include "../solvers/reduction.hpp"
 #include "linear_jacobian.hpp"
-#include "simulation.hpp"
 
 namespace rfem {
 

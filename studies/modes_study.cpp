@@ -4,8 +4,8 @@
 
 #include <cmath>
 
+#include "../simulation/validity.hpp"
 #include "../solvers/beam_theory.hpp"
-#include "validity.hpp"
 
 namespace rfem {
 

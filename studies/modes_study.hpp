@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "../results/writer.hpp"
+#include "../simulation/common.hpp"
 #include "../solvers/modes.hpp"
-#include "common.hpp"
 
 namespace rfem {
 

@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "../core/positions.hpp"
-#include "checkpoints.hpp"
+#include "../simulation/state.hpp"
 #include "../solvers/modes.hpp"
 #include "../solvers/statics.hpp"
 

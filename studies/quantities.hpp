@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "../simulation/common.hpp"
 #include "../solvers/equations.hpp"
-#include "common.hpp"
 #include "runs.hpp"
 
 namespace rfem {

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <map>
 
-#include "inputs.hpp"
+#include "../simulation/inputs.hpp"
 
 namespace rfem {
 

@@ -6,10 +6,10 @@
 #include <sstream>
 
 #include "../results/writer.hpp"
-#include "checkpoints.hpp"
-#include "inputs.hpp"
-#include "recorders.hpp"
-#include "sensors.hpp"
+#include "../simulation/inputs.hpp"
+#include "../simulation/recorders.hpp"
+#include "../simulation/sensors.hpp"
+#include "../simulation/state.hpp"
 
 namespace rfem {
 
@@ -123,7 +123,7 @@ void verify_kept(const ResumePlan& plan, const Model& model) {
                           std::to_string(c.rows) + " rows × " + std::to_string(sensor_cols) + "): not resumed");
       }
       try {
-        RunState::unpack(c.state, -1);
+        RunState::unpack(c.state);
       } catch (const std::invalid_argument& e) {
         throw CaseError(plan.path + ": " + run + ": " + e.what() + ": not resumed");
       }
@@ -182,6 +182,38 @@ std::vector<RunResult> resume_case(const ResumePlan& plan, RunRequest rq) {
     }
   }
   return runs;
+}
+
+}  // namespace rfem
+
+namespace rfem {
+
+SimulationState checkpoint_state(const std::string& results) {
+  const ResumePlan plan = plan_resume(results);
+  if (plan.cs.sim.procedure != Procedure::Single)
+    throw CaseError(results + ": its procedure runs " + std::to_string(runs_of(plan.cs.sim.procedure).size()) +
+                    " runs: a simulation's state is a single run's (rfem run --resume goes on with this file)");
+  const auto c = plan.resume.find(to_string(RunName::Run));
+  if (c == plan.resume.end() || c->second.state.empty())
+    throw CaseError(results + (plan.finished() ? ": its run completed: no state is kept at its end (a checkpoint is a killed run's)"
+                                               : ": its run wrote no checkpoint to go on from"));
+  SimulationState s;
+  try {
+    s = RunState::unpack(c->second.state).state;
+  } catch (const std::invalid_argument& e) {
+    throw CaseError(results + ": run: " + e.what());
+  }
+  s.model = model_signature(*model_of(plan.cs, plan.n), joint_inputs(plan.cs));
+  return s;
+}
+
+SimulationState read_state(const std::string& path) {
+  bool state_file = false;
+  {
+    const ResultsReader in(path);  // (ResultsError naming the file for what is not one)
+    state_file = !in.attribute("state", "model").empty();
+  }
+  return state_file ? load_state(path) : checkpoint_state(path);
 }
 
 }  // namespace rfem

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "../simulation/state.hpp"
 #include "runs.hpp"
 
 namespace rfem {
@@ -34,5 +35,13 @@ ResumePlan plan_resume(const std::string& results);
 /// their whole series (read back from the file). ParaView's views
 /// are the caller's, as after run_case (write_views).
 std::vector<RunResult> resume_case(const ResumePlan& plan, RunRequest request);
+
+/// A single run's newest checkpoint (an interrupted or killed `rfem run`'s) as a simulation's
+/// state, to start rfem.Simulation or a case (simulation.state) from: the same state format
+/// (simulation/state.hpp), its model's signature from the file's case and n. CaseError naming the
+/// file for a procedure of several runs, a run that completed or wrote no checkpoint.
+SimulationState checkpoint_state(const std::string& results);
+/// A state file (save_state) or, failing that, a single run's results file (checkpoint_state).
+SimulationState read_state(const std::string& path);
 
 }  // namespace rfem

@@ -2,10 +2,11 @@
 
 #include "../results/errors.hpp"
 #include "../results/writer.hpp"
-#include "common.hpp"
-#include "inputs.hpp"
-#include "recorders.hpp"
-#include "simulation.hpp"
+#include "../simulation/common.hpp"
+#include "../simulation/inputs.hpp"
+#include "../simulation/recorders.hpp"
+#include "../simulation/simulation.hpp"
+#include "resume.hpp"
 
 namespace rfem {
 
@@ -17,7 +18,9 @@ FileRuns run_from_state(const Case& cs, const RunRequest& rq, const std::string&
   o.made_by = made_by;
   o.driven_by = "";  // (the case's own laws: see plan_resume for why it still does not resume)
   try {
-    o.state = std::make_shared<const SimulationState>(load_state(cs.sim.state));
+    o.state = std::make_shared<const SimulationState>(read_state(cs.sim.state));
+  } catch (const CaseError& e) {  // (a results file's checkpoint that is not a state)
+    throw CaseError(cs.path + ": simulation.state: " + e.what());
   } catch (const ResultsError& e) {
     throw CaseError(cs.path + ": simulation.state: " + e.what());
   } catch (const std::invalid_argument& e) {

@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "../simulation/simulation.hpp"
 #include "linearize.hpp"
 #include "modes_study.hpp"
 #include "refine.hpp"
-#include "simulation.hpp"
 #include "runs.hpp"
 
 namespace rfem {
@@ -31,7 +31,7 @@ struct FileRuns {
 /// rq.warn). `made_by` is the command line or call kept in the file. Every row a run computed is in
 /// the file whatever its status.
 /// A case whose [simulation] starts from a saved state (`state`): its one run as a stepped
-/// simulation from that state (studies/simulation.hpp), into `output` if not "", with rq's n,
+/// simulation from that state (simulation/simulation.hpp), into `output` if not "", with rq's n,
 /// threads, observers, series, warnings and stop token. CaseError naming simulation.state for a
 /// file that is not a state, or the state of another model.
 FileRuns run_from_state(const Case& cs, const RunRequest& rq, const std::string& output, const std::string& made_by);

@@ -5,10 +5,10 @@
 #include <algorithm>
 #include <functional>
 
+#include "../simulation/inputs.hpp"
 #include "../solvers/equations.hpp"
 #include "../solvers/modes.hpp"
 #include "../solvers/reduction.hpp"
-#include "inputs.hpp"
 
 namespace rfem {
 

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "validity.hpp"
+#include "../simulation/validity.hpp"
 
 namespace rfem {
 

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "../assembly/assemble.hpp"
+#include "../simulation/common.hpp"
 #include "../solvers/statics.hpp"
-#include "common.hpp"
 
 namespace rfem {
 

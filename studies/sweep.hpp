@@ -23,8 +23,8 @@
 #include "../cases/case_file.hpp"
 #include "../cases/sweep_file.hpp"
 #include "../results/sweep_index.hpp"
+#include "../simulation/common.hpp"
 #include "../solvers/run_status.hpp"
-#include "common.hpp"
 
 namespace rfem {
 

@@ -5,3 +5,10 @@ src=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 cd "$dir"
+# `rfem plot` calls the package's entry point (rfem.plots:main) inside the program; a build without
+# Python (the sanitizer build) has only the entry point itself, run by python3.
+if "$rfem" plot /dev/null 2>&1 | grep -q "built without Python"; then
+  rfem_plot() { /usr/bin/python3 -P -m rfem.plots "$@"; }
+else
+  rfem_plot() { "$rfem" plot "$@"; }
+fi

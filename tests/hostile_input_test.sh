@@ -166,7 +166,7 @@ start_long_run killed.h5
 kill -KILL $pid; wait $pid 2>/dev/null
 s=$(status killed.h5 run)
 [[ $s == "running | none | "* ]] && ok "a killed run's file reads with swmr=True: $s" || bad "killed.h5: $s"
-"$rfem" plot killed.h5 -o plots > /dev/null 2> err.txt && ls plots/run_joints.png > /dev/null 2>&1 \
+rfem_plot killed.h5 -o plots > /dev/null 2> err.txt && ls plots/run_joints.png > /dev/null 2>&1 \
   && ok "rfem plot draws a killed run" || bad "plot of a killed run: $(cat err.txt)"
 
 # 9. A full disk (root only: a small tmpfs) ends the run as failed with the rows before it readable

@@ -75,7 +75,7 @@ sys.exit(0 if m[0]['kind'] == 'rigid' and m[1]['frequency_hz'] > 0.1 else 1)" \
   && ok "wrist freed: rigid mode first" || bad "modes --free wrist"
 
 # 5. Plots of the two-link run; the paper procedure with links 2 and 3 flexible.
-"$rfem" plot arm.h5 -o figs > /dev/null && [ -s figs/run_tip.png ] && ok "plot of two links" || bad "plot"
+rfem_plot arm.h5 -o figs > /dev/null && [ -s figs/run_tip.png ] && ok "plot of two links" || bad "plot"
 "$rfem" run "$src/cases/paper_two_flexible.toml" --set simulation.t_end=2 -q -o p2.h5 \
   && /usr/bin/python3 -c "
 import sys, h5py; f = h5py.File('p2.h5', 'r')

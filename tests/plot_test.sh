@@ -5,9 +5,9 @@
 set -euo pipefail
 source "$(dirname "$0")/cli_test_env.sh"
 "$rfem" run "$src/cases/paper_deployment.toml" --quiet --set simulation.t_end=4 -o paper.h5
-"$rfem" plot paper.h5 -o figs >/dev/null
+rfem_plot paper.h5 -o figs >/dev/null
 "$rfem" run "$src/cases/space_deployment.toml" --quiet --n 2 --set simulation.t_end=4 -o space.h5 2>/dev/null
-"$rfem" plot space.h5 -o figs >/dev/null
+rfem_plot space.h5 -o figs >/dev/null
 /usr/bin/python3 - figs <<'PY'
 import sys, os
 import matplotlib.image as mpimg
@@ -32,16 +32,16 @@ sys.exit(1 if bad else 0)
 PY
 # An unreadable results file: one-line error, exit 2.
 echo "not hdf5" > bad.h5
-if "$rfem" plot bad.h5 2>err.txt; then echo "FAIL: plot accepted a non-HDF5 file"; exit 1; fi
+if rfem_plot bad.h5 2>err.txt; then echo "FAIL: plot accepted a non-HDF5 file"; exit 1; fi
 grep -q "rfem plot: error: bad.h5" err.txt || { echo "FAIL: message"; cat err.txt; exit 1; }
 # Figures for print: PDF, with the paper's signs of u1, u2.
-"$rfem" plot paper.h5 -o pdf --format pdf --paper-signs >/dev/null
+rfem_plot paper.h5 -o pdf --format pdf --paper-signs >/dev/null
 head -c 4 pdf/fig5_tip.pdf | grep -q "%PDF" || { echo "FAIL: no PDF"; exit 1; }
 echo "ok pdf"
-# rfem plot runs the package's module (python3 -m rfem.plots) found beside the program: not an rfem/
+# rfem plot calls the package's entry point (rfem.plots:main) found beside the program: not an rfem/
 # in the current directory, and RFEM_PYTHONPATH, when set, must hold the package.
 mkdir -p decoy/rfem && echo 'raise SystemExit("the rfem/ of the current directory was imported")' > decoy/rfem/__init__.py
-(cd decoy && "$rfem" plot ../paper.h5 -o ../decoyfigs >/dev/null 2>err.txt) || { echo "FAIL: decoy package"; cat decoy/err.txt; exit 1; }
+(cd decoy && rfem_plot ../paper.h5 -o ../decoyfigs >/dev/null 2>err.txt) || { echo "FAIL: decoy package"; cat decoy/err.txt; exit 1; }
 [ -s decoyfigs/fig5_tip.png ] || { echo "FAIL: no figures beside a decoy rfem/"; exit 1; }
 echo "ok rfem/ of the current directory not imported"
 if RFEM_PYTHONPATH=/nonexistent "$rfem" plot paper.h5 -o none 2>err.txt; then echo "FAIL: a wrong RFEM_PYTHONPATH accepted"; exit 1; fi

@@ -32,7 +32,7 @@ for k, v in checks.items():
 sys.exit(0 if all(checks.values()) else 1)
 PY
 grep -q "rfem: warning: peak:u2:" ref.err || { echo "FAIL: no warning on stderr"; exit 1; }
-"$rfem" plot ref.h5 -o figs >/dev/null
+rfem_plot ref.h5 -o figs >/dev/null
 test -s figs/refine_convergence.png && test -s figs/refine_convergence_q1.png || { echo "FAIL: figures"; exit 1; }
 # Interrupted: exit 130, the rows done so far in the file and on stdout.
 "$rfem" refine "$src/cases/paper_deployment.toml" --n 6,8,4000 --quantity force/peak:u1 -q -o part.h5 > part.txt &
@@ -56,5 +56,5 @@ print(("ok  " if ok else "FAIL"), "partial table kept:", list(f["refine/n"][:]),
 sys.exit(0 if ok else 1)
 PY
 grep -q "^     8 " part.txt || { echo "FAIL: partial table not printed"; exit 1; }
-"$rfem" plot part.h5 -o figs2 >/dev/null
+rfem_plot part.h5 -o figs2 >/dev/null
 echo "refine: all passed"

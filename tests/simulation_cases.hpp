@@ -7,7 +7,7 @@
 #include <cmath>
 #include <string>
 
-#include "../studies/simulation.hpp"
+#include "../simulation/simulation.hpp"
 #include "tests/test_models.hpp"
 
 namespace rfem::test {

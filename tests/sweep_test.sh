@@ -264,6 +264,6 @@ set -e
 echo "ok   an index that cannot be replaced: exit $code, no k.h5.tmp: $(grep error k.err)"
 rmdir k.h5
 # The index plots: each quantity against each parameter, orders over n.
-"$rfem" plot one.h5 -o figs > /dev/null
+rfem_plot one.h5 -o figs > /dev/null
 test -s figs/sweep_peak_u1_vs_n.png && test -s figs/sweep_tau1_3_vs_joints.0.input.T.png || { echo "FAIL: sweep figures"; ls figs; exit 1; }
 echo "ok   rfem plot: $(ls figs | wc -l) figures"

@@ -8,7 +8,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "../studies/simulation.hpp"
+#include "../simulation/simulation.hpp"
+#include "../studies/runs.hpp"
 #include "tests/simulation_cases.hpp"
 #include "tests/test_models.hpp"
 

@@ -5,9 +5,9 @@
 // stops with a clear status before the yaw–pitch–roll angles become singular.
 #include <gtest/gtest.h>
 
-#include "../studies/inputs.hpp"
 #include "../assembly/dense_reference.hpp"
 #include "../assembly/momentum.hpp"
+#include "../simulation/inputs.hpp"
 #include "../solvers/integrator.hpp"
 #include "tests/test_models.hpp"
 

@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "../assembly/workspace.hpp"
-#include "../studies/inputs.hpp"
+#include "../simulation/inputs.hpp"
 #include "../solvers/integrator.hpp"
 #include "../solvers/thread_governor.hpp"
 #include "tests/test_models.hpp"

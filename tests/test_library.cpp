@@ -8,12 +8,12 @@
 #include <filesystem>
 
 #include "../assembly/assemble.hpp"
+#include "../results/reader.hpp"
+#include "../simulation/inputs.hpp"
+#include "../simulation/recorders.hpp"
 #include "../solvers/equations.hpp"
 #include "../solvers/mass_solve.hpp"
 #include "../solvers/statics.hpp"
-#include "../results/reader.hpp"
-#include "../studies/inputs.hpp"
-#include "../studies/recorders.hpp"
 #include "../studies/runs.hpp"
 #include "tests/test_models.hpp"
 

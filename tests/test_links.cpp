@@ -11,8 +11,8 @@
 #include <limits>
 #include <sstream>
 
-#include "../studies/inputs.hpp"
 #include "../assembly/momentum.hpp"
+#include "../simulation/inputs.hpp"
 #include "../solvers/integrator.hpp"
 #include "../solvers/modes.hpp"
 #include "../solvers/statics.hpp"

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "../studies/inputs.hpp"
+#include "../simulation/inputs.hpp"
 #include "../solvers/integrator.hpp"
 #include "tests/test_models.hpp"
 

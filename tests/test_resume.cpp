@@ -9,11 +9,11 @@
 #include <iterator>
 
 #include "../results/writer.hpp"
-#include "../studies/inputs.hpp"
+#include "../simulation/inputs.hpp"
+#include "../simulation/recorders.hpp"
+#include "../simulation/simulation.hpp"
 #include "../studies/quantities.hpp"
-#include "../studies/recorders.hpp"
 #include "../studies/resume.hpp"
-#include "../studies/simulation.hpp"
 #include "tests/test_models.hpp"
 
 using namespace rfem;
@@ -44,6 +44,40 @@ std::vector<Quantity> quantities(const Case& cs) {
 
 std::string temp_file(const std::string& name) {
   return (std::filesystem::temp_directory_path() / ("rfem_test_resume_" + std::to_string(::getpid()) + "_" + name)).string();
+}
+
+// Kane's beam on a hub under a digital PD with a delay of two samples (held values are the law's
+// memory, not the integrator's), 6 rfes.
+Case digital_pd_hub(double t_end) {
+  return read_case(test::source_path("cases/kane_hub_drive.toml"),
+                   {"link.n=6", "simulation.t_end=" + std::to_string(t_end), "simulation.output_dt=0.01",
+                    "joints.0.input={kind=\"pd\", reference={kind=\"spinup\", Omega=1.0, T=2.0}, kp=4.0e4, kd=1.2e4, "
+                    "sample_time=1e-3, delay=2}"});
+}
+
+RunRequest one_thread() {
+  RunRequest rq;
+  rq.threads = 1;
+  return rq;
+}
+
+// A results file of the case's procedure at n rfes (one thread, a checkpoint after every step or
+// output) stopped at the k-th output of run `run`, as an interrupted `rfem run` leaves it.
+std::string stopped_run_file(const Case& cs, int n, const std::string& run, long k, const std::string& name) {
+  const std::string path = temp_file(name);
+  const auto model = model_of(cs, n);
+  ResultsWriter file(path, describe(cs, "test_resume", cs.sim.procedure == Procedure::Paper ? "paper" : "single", model->n(), 1, n));
+  Hdf5Recorder recorder(file);
+  RunRequest rq;
+  rq.n = n;
+  rq.threads = 1;
+  rq.keep_series = false;
+  rq.checkpoint_interval = 1e-9;
+  StopAt stop(rq.stop, run, k);
+  rq.observers = {&recorder, &stop};
+  EXPECT_EQ(run_case(cs, model, joint_inputs(cs, {}), rq).back().status.kind, RunStatus::Kind::Interrupted);
+  file.close();
+  return path;
 }
 
 }  // namespace
@@ -129,28 +163,10 @@ TEST(Resume, ADigitalPdGoesOnFromItsHeldAndDelayedValues) {
   // A digital PD with a delay of two samples (held values are the law's memory, not the
   // integrator's): stopped at an output and resumed from its checkpoint, the run ends bit for bit
   // as the uninterrupted one (it would not if the held or delayed torques restarted from zero).
-  const Case cs = read_case(test::source_path("cases/kane_hub_drive.toml"),
-                            {"link.n=6", "simulation.t_end=1.0", "simulation.output_dt=0.01",
-                             "joints.0.input={kind=\"pd\", reference={kind=\"spinup\", Omega=1.0, T=2.0}, kp=4.0e4, kd=1.2e4, "
-                             "sample_time=1e-3, delay=2}"});
-  RunRequest whole;
-  whole.threads = 1;
-  const RunResult ref = run_case(cs, whole).at(0);
+  const Case cs = digital_pd_hub(1.0);
+  const RunResult ref = run_case(cs, one_thread()).at(0);
   ASSERT_TRUE(ref.completed()) << ref.status;
-  const std::string path = temp_file("digital.h5");
-  const auto model = model_of(cs, 6);
-  {
-    ResultsWriter file(path, describe(cs, "test_resume", "single", model->n(), 1, 6));
-    Hdf5Recorder recorder(file);
-    RunRequest rq;
-    rq.threads = 1;
-    rq.keep_series = false;
-    rq.checkpoint_interval = 1e-9;
-    StopAt stop(rq.stop, "run", 37);
-    rq.observers = {&recorder, &stop};
-    EXPECT_EQ(run_case(cs, model, joint_inputs(cs, {}), rq).at(0).status.kind, RunStatus::Kind::Interrupted);
-    file.close();
-  }
+  const std::string path = stopped_run_file(cs, 6, "run", 37, "digital.h5");
   const ResumePlan plan = plan_resume(path);
   ASSERT_EQ(plan.resume.count("run"), 1u);
   RunRequest rq;
@@ -278,4 +294,72 @@ TEST(Resume, NoisySensorsResumeBitForBitAndASteppedRunIsRefused) {
   }
   EXPECT_EQ(std::filesystem::last_write_time(stepped), before);
   std::filesystem::remove(stepped);
+}
+
+// One state format: a checkpoint holds the run's SimulationState. With BDF every checkpoint is at an
+// output the run recorded, so the state's sensor streams are those before that row (as a state
+// taken there by a caller): the resumed run draws that row's noise past (SensorBank::skip) and
+// every later row reads the uninterrupted run's noise. The encoder reads the prescribed spin-up,
+// exact in both runs, so the rows agree bit for bit only if the noise does (a stream one row
+// behind differs by the noise itself, 1e-3).
+TEST(Resume, ACheckpointAtARecordedRowGoesOnWithTheSameSensorNoise) {
+  const Case cs = read_case(test::source_path("cases/kane_spinup.toml"),
+                            {"link.n=6", "simulation.t_end=1.0", "simulation.output_dt=0.01", "simulation.integrator=\"bdf\"",
+                             "sensors=[{name=\"enc\", kind=\"encoder\", joint=\"hub\", noise=1e-3}]"});
+  RunRequest whole;
+  whole.threads = 1;
+  const RunResult ref = run_case(cs, whole).at(0);
+  ASSERT_TRUE(ref.completed()) << ref.status;
+  const std::string path = stopped_run_file(cs, 6, "run", 43, "bdf_sensors.h5");
+  const ResumePlan plan = plan_resume(path);
+  ASSERT_EQ(plan.resume.count("run"), 1u);
+  const RunState at = RunState::unpack(plan.resume.at("run").state);
+  const long k = at.state.integrator.next_output - 1;
+  ASSERT_EQ(output_time(cs.sim.options, k), at.state.time()) << "the BDF checkpoint is not at an output";
+  RunRequest rq;
+  rq.threads = 1;
+  ASSERT_TRUE(resume_case(plan, rq).at(0).completed());
+  const Table rows = ResultsReader(path).table("run/sensors");
+  ASSERT_EQ(rows.rows, ref.sensors.rows);
+  EXPECT_TRUE(rows.data == ref.sensors.data) << "the resumed rows' noise differs from the uninterrupted run's";
+  std::filesystem::remove(path);
+}
+
+// A killed run's checkpoint is a simulation's state: a Simulation started from it (as from a state
+// a caller took) goes on bit for bit as the uninterrupted run with ESDIRK, the digital PD's held
+// and delayed torques included; a file of the paper's procedure (three runs) is refused by name.
+TEST(Resume, AKilledRunsCheckpointIsASimulationState) {
+  const Case cs = digital_pd_hub(0.6);
+  const RunResult ref = run_case(cs, one_thread()).at(0);
+  ASSERT_TRUE(ref.completed()) << ref.status;
+  const std::string path = stopped_run_file(cs, 6, "run", 29, "killed.h5");
+  const SimulationState st = read_state(path);
+  EXPECT_EQ(st.model, model_signature(*model_of(cs, 6), joint_inputs(cs, {})));
+  EXPECT_GT(st.time(), 0.27);
+  EXPECT_FALSE(st.laws.empty());
+  SimulationOptions o;
+  o.threads = 1;
+  o.keep_series = true;
+  o.state = std::make_shared<const SimulationState>(st);
+  Simulation sim(cs, o);
+  sim.advance(sim.t_end());
+  const RunResult rest = sim.finish();
+  ASSERT_TRUE(rest.completed()) << rest.status;
+  // The state's own row first (off the output grid), then the outputs after it: the reference's last rows.
+  const Table x = ref.series->table("joint_tau"), y = rest.series->table("joint_tau");
+  const long later = y.rows - 1;
+  ASSERT_GT(later, 10);
+  ASSERT_EQ(x.cols, y.cols);
+  EXPECT_TRUE(std::equal(x.data.end() - later * x.cols, x.data.end(), y.data.end() - later * y.cols))
+      << "the run from the checkpoint's state differs from the uninterrupted one";
+  std::filesystem::remove(path);
+
+  const std::string paper_file = stopped_run_file(paper(), 6, "kinematic", 10, "paper_killed.h5");
+  try {
+    read_state(paper_file);
+    ADD_FAILURE() << "a paper procedure's file was read as one simulation's state";
+  } catch (const CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("a simulation's state is a single run's"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(paper_file);
 }

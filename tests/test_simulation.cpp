@@ -1,4 +1,4 @@
-// A simulation a caller steps (studies/simulation.hpp): one advance to the end is `rfem run` bit for
+// A simulation a caller steps (simulation/simulation.hpp): one advance to the end is `rfem run` bit for
 // bit; chunks agree with one run to the integrator's accuracy; a simulation started from a saved
 // state continues the original bit for bit; a held torque equal to the case's law changes nothing;
 // the energy books balance with a held torque; bad arguments are refused with one line; IDA steps
@@ -13,10 +13,11 @@
 
 #include "../core/positions.hpp"
 #include "../results/reader.hpp"
-#include "../studies/inputs.hpp"
-#include "../studies/sensors.hpp"
+#include "../simulation/inputs.hpp"
+#include "../simulation/sensors.hpp"
+#include "../simulation/simulation.hpp"
+#include "../studies/runs.hpp"
 #include "../studies/show.hpp"
-#include "../studies/simulation.hpp"
 #include "tests/simulation_cases.hpp"
 #include "tests/test_models.hpp"
 

@@ -19,8 +19,8 @@
 #include <sstream>
 #include <string>
 
+#include "rfem/simulation/simulation.hpp"
 #include "rfem/solvers/inputs.hpp"
-#include "rfem/studies/simulation.hpp"
 
 namespace {
 

@@ -10,8 +10,8 @@
 #include <cstdio>
 #include <string>
 
+#include "rfem/simulation/recorders.hpp"
 #include "rfem/solvers/beam_theory.hpp"
-#include "rfem/studies/recorders.hpp"
 #include "rfem/studies/runs.hpp"
 #include "rfem/studies/static_study.hpp"
 

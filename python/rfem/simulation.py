@@ -8,7 +8,7 @@
     state = sim.state()                         # start other simulations from it, save, pickle
     run = sim.finish()                          # the Run (status, peaks, series)
 
-The library's studies/simulation.hpp does the work; see README.md, "Control in the loop".
+The library's simulation/simulation.hpp does the work; see README.md, "Control in the loop".
 """
 
 import os as _os
@@ -39,7 +39,8 @@ def _raise(error, result):
 
 
 def load_state(path):
-    """A state saved with SimulationState.save (HDF5) or numpy.savez (.npz with `model`, `packed`)."""
+    """A state saved with SimulationState.save (HDF5) or numpy.savez (.npz with `model`, `packed`),
+    or a single run's results file: its newest checkpoint (a run that was interrupted or killed)."""
     path = _os.fspath(path)
     if path.endswith(".npz"):
         import numpy as np

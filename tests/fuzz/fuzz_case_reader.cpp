@@ -15,7 +15,7 @@
 #include <string>
 
 #include "../../cases/case_file.hpp"
-#include "../../studies/inputs.hpp"
+#include "../../simulation/inputs.hpp"
 
 namespace {
 void write(const std::string& path, const std::string& text) {

@@ -230,3 +230,13 @@ def test_controller_outputs_and_pickles_are_checked_in_rfems_words(tmp_path):
         o.__setstate__(tuple(st))
     assert rfem.RunStatus.parse("interrupted (signal 99999999999)").signal in (None, 0)
     assert rfem.RunStatus.parse("interrupted (signal 15)").signal == 15
+
+
+def test_a_results_file_is_a_state_only_while_its_run_has_a_checkpoint(tmp_path):
+    # rfem.load_state reads a killed single run's newest checkpoint (one state format; the C++ test
+    # Resume.AKilledRunsCheckpointIsASimulationState continues one bit for bit); a run that completed
+    # keeps no state at its end: one line naming the file.
+    case = hub(t_end=0.1)
+    rfem.run(case, output=str(tmp_path / "done.h5"), threads=1)
+    with pytest.raises(rfem.CaseError, match=r"done.h5: its run completed"):
+        rfem.load_state(tmp_path / "done.h5")

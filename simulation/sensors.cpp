@@ -144,12 +144,23 @@ void SensorBank::read(const VecX& q, const VecX& v, const VecX& a, const VecX& t
         break;
       }
     }
-    if (stream < 0) continue;
-    std::normal_distribution<double> noise(0.0, 1.0);
-    for (size_t i = first; i < out.size(); ++i) {
-      if (r.spec.noise > 0) out[i] += r.spec.noise * noise(r.random[stream]);
-      if (r.spec.quantum > 0) out[i] = r.spec.quantum * std::round(out[i] / r.spec.quantum);
-    }
+    if (stream >= 0) measure(r, out.data() + first, out.size() - first, stream);
+  }
+}
+
+void SensorBank::measure(Resolved& r, double* x, size_t count, int stream) {
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (size_t i = 0; i < count; ++i) {
+    if (r.spec.noise > 0) x[i] += r.spec.noise * noise(r.random[stream]);
+    if (r.spec.quantum > 0) x[i] = r.spec.quantum * std::round(x[i] / r.spec.quantum);
+  }
+}
+
+void SensorBank::skip(int stream) {
+  std::vector<double> x;
+  for (size_t i = 0; i < sensors_.size(); ++i) {
+    x.assign(static_cast<size_t>(width(i)), 0.0);
+    measure(sensors_[i], x.data(), x.size(), stream);  // (the draws do not depend on the values)
   }
 }
 

@@ -16,40 +16,15 @@
 #include <string>
 #include <vector>
 
-#include "runs.hpp"
 #include "../solvers/stepper.hpp"
+#include "run_book.hpp"
+#include "state.hpp"
 
 namespace rfem {
 
 class SensorBank;
 
-/// Everything a simulation needs to go on from where it was: the integrator's state (time,
-/// coordinates, rates, accelerations, step size, energy integrals) and the drives' held values,
-/// with the signature of its model (another model's state is refused).
-struct SimulationState {
-  std::string model;           ///< model_signature() of the model it belongs to
-  IntegratorState integrator;
-  /// Per joint, what it holds: kHeldNone, kHeldTorque (τ) or kHeldReference (q_ref, q̇_ref, τ_ff).
-  std::vector<double> drives;
-  /// What the joints' laws remember (pack_law_memory: a digital PD's held and delayed values).
-  std::vector<double> laws;
-  /// Where the sensors' noise is (SensorBank::save): the recorded rows' streams (before the row at
-  /// the state's time, which a simulation started from it records again), then the snapshots'.
-  std::vector<double> sensors;
-  double time() const { return integrator.t; }
-  /// As doubles (a version first), and back (std::invalid_argument for text that is not one).
-  std::vector<double> pack() const;
-  static SimulationState unpack(const std::string& model, const std::vector<double>& x);
-};
-
-/// "n=12; links=link:12; joints=hub:revolute:torque,...; unknowns=73": what a state must match.
-std::string model_signature(const Model& model, const std::vector<JointInput>& inputs);
-/// A state in an HDF5 file of its own (dataset state/packed, attribute state/model) and back
-/// (ResultsError / std::invalid_argument naming the file).
-void save_state(const SimulationState& state, const std::string& path);
-SimulationState load_state(const std::string& path);
-
-/// A simulation's options: a run's (studies/runs.hpp), and where it writes and starts from.
+/// A simulation's options: a run's (simulation/run_book.hpp), and where it writes and starts from.
 struct SimulationOptions : RunOptions {
   SimulationOptions() { keep_series = false; }  // (a stepped run keeps its series only if asked)
   std::string output;        ///< results file ("": none; observers may still record)
@@ -68,18 +43,18 @@ struct Snapshot {
   VecX joint_q, joint_v, joint_tau;        ///< per joint [rad or m, /s, N m or N]
   std::vector<Vec3> tip_position;          ///< per link, in {0} [m]
   std::vector<Vec3> tip_deflection;        ///< per link: u1, u2 [m], θ [rad] in {r}
-  /// The case's [[sensors]] by name, as measured (noise, resolution; studies/sensors.hpp).
+  /// The case's [[sensors]] by name, as measured (noise, resolution; simulation/sensors.hpp).
   std::vector<std::pair<std::string, std::vector<double>>> sensors;
 };
 
 /// The one engine that advances a run: `rfem run`'s procedure (run_case: a Simulation per run,
 /// advanced to t_end), a caller's stepping and a controller's loop alike. It owns the run's model,
 /// equations and stepper (solvers/stepper.hpp: ESDIRK, IDA's BDF, or inverse dynamics without
-/// unknowns) and its book (RunBook); files are written by observers (studies/recorders.hpp).
+/// unknowns) and its book (RunBook); files are written by observers (simulation/recorders.hpp).
 class Simulation {
  public:
   /// The case's run on its own model (opts.n rfes) and inputs, stepped by the caller. CaseError for
-  /// a case that cannot run (studies/runs.hpp: check_runnable) or has nothing to step;
+  /// a case that cannot run (simulation/run_book.hpp: check_runnable) or has nothing to step;
   /// std::invalid_argument for a state of another model; the results file, if any, is created here
   /// (ResultsError for a path it cannot create).
   Simulation(const Case& cs, SimulationOptions opts);

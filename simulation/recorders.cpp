@@ -1,5 +1,5 @@
 #include "recorders.hpp"
-#include "checkpoints.hpp"
+#include "state.hpp"
 
 #include "../results/xdmf.hpp"
 

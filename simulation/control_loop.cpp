@@ -1,4 +1,4 @@
-// A digital controller in the loop (studies/simulation.hpp: run_controlled): the controller is the
+// A digital controller in the loop (simulation/simulation.hpp: run_controlled): the controller is the
 // simulation's sample-and-hold (Simulation::sample_every: the stepper stops at its samples as at a
 // digital law's), its output held from its sample (zero-order hold) and recorded in the run's group
 // (run/control).

@@ -1,6 +1,6 @@
 #pragma once
-// What every study shares: where warnings go (the library never prints), the joint state of a
-// case with an optional steady rate, and the case's model as a shared object.
+// What the engine and every study share: where warnings go (the library never prints), the joint
+// state of a case with an optional steady rate, and the case's model as a shared object.
 #include <functional>
 #include <memory>
 #include <string>

@@ -32,6 +32,8 @@ class SensorBank {
   /// restore throws std::invalid_argument for another bank's state.
   std::vector<double> save() const;
   void restore(const std::vector<double>& state);
+  /// Advances the streams of `stream` as read() would, without reading (a row already recorded).
+  void skip(int stream);
 
  private:
   // A random engine that counts its draws: its state is (seed, count).
@@ -52,6 +54,8 @@ class SensorBank {
     double EI = 0.0;  // strain: the bending stiffness of the gauge's section [N m²]
     Stream random[2];
   };
+  // A sensor's exact values x[0..count) as measured: noise from `stream`, then quantisation.
+  static void measure(Resolved& r, double* x, size_t count, int stream);
   const Model& model_;
   std::vector<Resolved> sensors_;
 };

@@ -4,7 +4,7 @@
 #include <memory>
 
 #include "../results/writer.hpp"
-#include "runs.hpp"
+#include "run_book.hpp"
 
 namespace rfem {
 

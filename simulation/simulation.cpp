@@ -9,7 +9,6 @@
 #include "../core/positions.hpp"
 #include "../results/errors.hpp"
 #include "../results/writer.hpp"
-#include "checkpoints.hpp"
 #include "common.hpp"
 #include "inputs.hpp"
 #include "recorders.hpp"
@@ -19,7 +18,6 @@ namespace rfem {
 
 namespace {
 
-constexpr double kStateVersion = 3.0;  // (1: no memory of the laws, 2: no sensors' noise; still read)
 // What a joint holds (SimulationState::drives: the mode, then τ, q_ref, q̇_ref, τ_ff).
 constexpr int kHeldNone = 0, kHeldTorque = 1, kHeldReference = 2, kDriveValues = 5;
 
@@ -58,97 +56,6 @@ class HeldLaw : public TorqueLaw {
 const char* kAxisNames[6] = {"x1", "x2", "x3", "phi1", "phi2", "phi3"};
 
 }  // namespace
-
-std::vector<double> SimulationState::pack() const {
-  std::vector<double> x = {kStateVersion, static_cast<double>(drives.size())};
-  x.insert(x.end(), drives.begin(), drives.end());
-  x.push_back(static_cast<double>(laws.size()));
-  x.insert(x.end(), laws.begin(), laws.end());
-  const std::vector<double> i = integrator.pack();
-  x.insert(x.end(), i.begin(), i.end());
-  x.push_back(static_cast<double>(sensors.size()));  // (after the integrator: its length is in its head)
-  x.insert(x.end(), sensors.begin(), sensors.end());
-  return x;
-}
-
-SimulationState SimulationState::unpack(const std::string& model, const std::vector<double>& x) {
-  const auto bad = [] { return std::invalid_argument("not a simulation state of this version of rfem"); };
-  // A count at x[i]: a whole number with that many values after it.
-  const auto count = [&](size_t i) {
-    if (i >= x.size() || !(x[i] >= 0) || x[i] != std::floor(x[i]) || x[i] > static_cast<double>(x.size() - i - 1)) throw bad();
-    return static_cast<size_t>(x[i]);
-  };
-  if (x.size() < 2 || (x[0] != kStateVersion && x[0] != 2.0 && x[0] != 1.0)) throw bad();
-  SimulationState s;
-  s.model = model;
-  const size_t nd = count(1);
-  s.drives.assign(x.begin() + 2, x.begin() + 2 + static_cast<long>(nd));
-  size_t i = 2 + nd;
-  const auto block = [&](std::vector<double>& to) {
-    const size_t k = count(i++);
-    to.assign(x.begin() + static_cast<long>(i), x.begin() + static_cast<long>(i + k));
-    i += k;
-  };
-  if (x[0] >= 2.0) block(s.laws);
-  size_t end = x.size();
-  if (x[0] >= 3.0) {  // the integrator's state (its head, then q, v, a), then the sensors' block
-    const size_t head = IntegratorState{}.pack_head().size();
-    if (i + head > x.size()) throw bad();
-    const double u = x[i + head - 1];
-    if (!(u >= 0 && u == std::floor(u) && u <= static_cast<double>(x.size()))) throw bad();
-    end = i + head + 3 * static_cast<size_t>(u);
-    if (end >= x.size()) throw std::invalid_argument("the state of " + std::to_string(static_cast<long>(u)) + " unknowns is cut short");
-    size_t j = end;
-    std::swap(i, j);
-    block(s.sensors);
-    std::swap(i, j);
-    if (j != x.size()) throw std::invalid_argument("the state has values after its end: not a state of this version of rfem");
-  }
-  for (double d : s.drives)
-    if (!std::isfinite(d)) throw std::invalid_argument("the state's held drive values are not finite");
-  for (double d : s.laws)  // (a digital law that has not sampled yet remembers its last sample at −inf)
-    if (std::isnan(d)) throw std::invalid_argument("the state's memory of the joints' laws holds NaN");
-  s.integrator = IntegratorState::unpack(std::vector<double>(x.begin() + static_cast<long>(i), x.begin() + static_cast<long>(end)), -1);
-  return s;
-}
-
-std::string model_signature(const Model& model, const std::vector<JointInput>& inputs) {
-  std::string s = "n=" + std::to_string(model.n()) + "; links=";
-  for (size_t l = 0; l < model.links.size(); ++l) {  // (a reduced link's state is over its own basis)
-    const Discretisation& d = model.links[l].d;
-    s += (l ? "," : "") + model.links[l].name + ":" + std::to_string(model.links[l].n());
-    if (d.modes > 0) s += ":modes=" + std::to_string(d.modes) + ":derivatives=" + std::to_string(d.derivatives);
-  }
-  s += "; joints=";
-  const std::vector<std::string> kinds = input_kinds(inputs);
-  for (int j = 0; j < model.m(); ++j)
-    s += (j ? "," : "") + model.joints[j].name + ":" + (model.joints[j].type == JointType::Revolute ? "revolute" : "prismatic") +
-         ":" + kinds[j];
-  return s;
-}
-
-void save_state(const SimulationState& state, const std::string& path) {
-  FileDescription d;
-  d.command_line = "rfem simulation state at t = " + std::to_string(state.time()) + " s";
-  d.procedure = "state";
-  ResultsWriter w(path, d);
-  const std::vector<double> x = state.pack();
-  w.write_table("state/packed", Table{static_cast<long>(x.size()), 1, x}, {"value"}, {""},
-                "a simulation's state (studies/simulation.hpp: SimulationState::pack)");
-  w.write_attribute("state", "model", state.model);
-  w.close();
-}
-
-SimulationState load_state(const std::string& path) {
-  const ResultsReader in(path);
-  const std::string model = in.attribute("state", "model");
-  if (model.empty()) throw std::invalid_argument(path + ": no simulation state in it (state/model)");
-  try {
-    return SimulationState::unpack(model, in.table("state/packed").data);
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(path + ": " + e.what());
-  }
-}
 
 struct Simulation::Impl {
   Case cs;
@@ -211,6 +118,20 @@ struct Simulation::Impl {
       held[j]->tau_ff = x[4];
     }
   }
+  // The drives, the laws' memory and the sensors' streams of a state (a caller's or a checkpoint's;
+  // its integrator's state is the stepper's start).
+  void go_on_from(const SimulationState& from) {
+    if (!from.drives.empty()) apply_drives(from.drives);         // (a checkpoint of layout 1 has none)
+    if (!from.laws.empty()) restore_law_memory(inputs, from.laws);  // (version 1: the laws start afresh)
+    // (version < 3: the noise starts afresh; a case without sensors has none to go on with)
+    if (from.sensors.empty() || !sensors) return;
+    const size_t half = from.sensors.size() / 2;
+    if (from.sensors.size() % 2 != 0) throw std::invalid_argument("the state's sensors' noise is damaged (an odd count)");
+    book->restore_sensor_streams(std::vector<double>(from.sensors.begin(), from.sensors.begin() + static_cast<long>(half)));
+    sensors->restore(std::vector<double>(from.sensors.begin() + static_cast<long>(half), from.sensors.end()));
+  }
+  // A state but for its integrator's, at time t (SimulationState: drives, laws, sensors).
+  SimulationState state_at(double t) const;
   void bring_inputs_up_to_date() {
     if (!changed || status.kind != RunStatus::Kind::Running) return;
     stepper->inputs_changed();
@@ -287,8 +208,8 @@ void Simulation::Impl::init(const Case& c, const std::string& name, const Checkp
     m.control.resume = &m.resume;
   }
   if (checkpoint) {
-    m.resumed = RunState::unpack(checkpoint->state, -1);
-    m.control.resume = &m.resumed.integrator;
+    m.resumed = RunState::unpack(checkpoint->state);
+    m.control.resume = &m.resumed.state.integrator;
   }
   if (!m.opts.output.empty()) {
     Parallelism p;
@@ -312,16 +233,20 @@ void Simulation::Impl::init(const Case& c, const std::string& name, const Checkp
     return;
   }
   if (from) {
-    m.apply_drives(from->drives);
-    if (!from->laws.empty()) restore_law_memory(m.inputs, from->laws);  // (version 1: the laws start afresh)
-    // (version < 3: the noise starts afresh; a case without sensors has none to go on with)
-    if (!from->sensors.empty() && m.sensors) {
-      const size_t half = from->sensors.size() / 2;
-      const std::vector<double> recorded(from->sensors.begin(), from->sensors.begin() + static_cast<long>(half));
-      if (from->sensors.size() % 2 != 0) throw std::invalid_argument("the state's sensors' noise is damaged (an odd count)");
-      m.book->restore_sensor_streams(recorded);
-      m.sensors->restore(std::vector<double>(from->sensors.begin() + static_cast<long>(half), from->sensors.end()));
+    m.go_on_from(*from);
+  } else if (checkpoint) {
+    if (m.sensors && m.resumed.state.sensors.empty())
+      throw std::invalid_argument("run " + name + ": its checkpoint holds no state of the sensors' noise (written by an older "
+                                  "rfem): not resumed, run the case again");
+    try {
+      m.go_on_from(m.resumed.state);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("run " + name + ": its checkpoint: " + e.what());
     }
+    // A checkpoint at an output the run recorded holds the streams before its row (a state's):
+    // the resumed run does not record it again.
+    const long k = m.resumed.state.integrator.next_output - 1;
+    if (k >= 0 && output_time(m.o, k) == m.resumed.state.time()) m.book->skip_sensor_row();
   }  // (after the equations took the case laws' gains for Newton)
   if (m.eq->unknowns() == 0 && (callers || from))
     throw CaseError(cs.path + ": joints: every joint follows a prescribed motion and there is no flexible link: nothing to step "
@@ -334,7 +259,18 @@ void Simulation::Impl::init(const Case& c, const std::string& name, const Checkp
   }
   m.control.heartbeat_interval = m.opts.progress_interval;
   m.control.checkpoint_interval = m.opts.checkpoint_interval;
-  m.control.checkpoint = [&m](const IntegratorState& st) { m.book->checkpoint(st); };
+  m.control.checkpoint = [&m](IntegratorState& st) {  // (the stepper's vectors lent, not copied)
+    SimulationState s = m.state_at(st.t);
+    s.model.clear();  // (a checkpoint belongs to its run's model)
+    std::swap(s.integrator, st);
+    try {
+      m.book->checkpoint(s);
+    } catch (...) {
+      std::swap(s.integrator, st);
+      throw;
+    }
+    std::swap(s.integrator, st);
+  };
   m.emit = std::make_unique<SampleEmitter>(m.sink, m.control);
   try {
     m.stepper = make_stepper(*m.eq, m.o);
@@ -510,14 +446,12 @@ Snapshot Simulation::snapshot() {
   return y;
 }
 
-SimulationState Simulation::state() const {
-  const Impl& m = *impl_;
+SimulationState Simulation::Impl::state_at(double t) const {
   SimulationState s;
-  s.model = m.signature;
-  s.integrator = m.now("state");
-  s.drives.assign(static_cast<size_t>(kDriveValues * m.model->m()), 0.0);
-  for (int j = 0; j < m.model->m(); ++j)
-    if (const HeldLaw* h = m.held[j].get()) {
+  s.model = signature;
+  s.drives.assign(static_cast<size_t>(kDriveValues * model->m()), 0.0);
+  for (int j = 0; j < model->m(); ++j)
+    if (const HeldLaw* h = held[j].get()) {
       double* d = s.drives.data() + kDriveValues * j;
       d[0] = h->mode;
       d[1] = h->tau;
@@ -525,12 +459,20 @@ SimulationState Simulation::state() const {
       d[3] = h->v_ref;
       d[4] = h->tau_ff;
     }
-  s.laws = pack_law_memory(m.inputs);
-  if (m.sensors) {
-    s.sensors = m.book->sensor_streams(s.integrator.t);
-    const std::vector<double> snap = m.sensors->save();
+  s.laws = pack_law_memory(inputs);
+  if (sensors) {
+    s.sensors = book->sensor_streams(t);
+    const std::vector<double> snap = sensors->save();
     s.sensors.insert(s.sensors.end(), snap.begin(), snap.end());
   }
+  return s;
+}
+
+SimulationState Simulation::state() const {
+  const Impl& m = *impl_;
+  IntegratorState x = m.now("state");
+  SimulationState s = m.state_at(x.t);
+  s.integrator = std::move(x);
   return s;
 }
 
