@@ -40,8 +40,21 @@ void print_tables(const Case& cs, const RefineResult& res) {
       fmt::print("{:>6} {:>20.12e} {:>14} {:>8} {:>20}\n", r.n, r.value, opt(r.change, "{:.3e}"), opt(r.order, "{:.3f}"),
                  opt(r.richardson, "{:.12e}"));
     fmt::print("fitted order (least squares over all changes): {}", opt(t.fitted_order, "{:.3f}"));
-    if (std::isfinite(t.integration_error)) fmt::print("; integration error at n = {}: {:.3e}", t.rows.back().n, t.integration_error);
+    const bool dynamic = res.quantities[k].dynamic();
+    if (dynamic && std::isfinite(t.integration_error))
+      fmt::print("; integration error at n = {}: {:.3e}", t.rows.back().n, t.integration_error);
     fmt::print("\n");
+    if (t.rows.empty()) continue;
+    const RefinementRow& last = t.rows.back();
+    if (!t.asymptotic) {
+      fmt::print("no error bar at n = {}: the series does not show the asymptotic range (see the warnings)\n", last.n);
+      continue;
+    }
+    const std::string time = !dynamic ? "none" : std::isfinite(t.error_time) ? fmt::format("{:.3e}", t.error_time)
+                                                                            : "not measured";
+    fmt::print("error bar at n = {}: {:.12e} ± {:.3e}{} (space {:.3e}: GCI, Fs = {:.2f}, order {:.3f}; time {})\n", last.n,
+               last.value, t.error, last.value != 0.0 ? fmt::format(", relative {:.2e}", t.error / std::abs(last.value)) : "",
+               t.error_space, t.safety_factor, t.observed_order(), time);
   }
 }
 
@@ -54,6 +67,8 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
   rq.modes = ro.modes;
   rq.quantities = ro.quantities;
   rq.integration_check = ro.integration_check;
+  rq.accuracy = ro.accuracy;  // (unset without --accuracy)
+  rq.max_n = ro.max_n;
   rq.rate = o.rate;
   rq.threads = c.threads;
   rq.warn = print_warning;
@@ -69,7 +84,8 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
     }
   }
   const bool quiet = c.json || c.quiet;
-  if (dynamic) check_run_cost(cs, model_of(cs, ro.ns.back()), joint_inputs(cs), c);  // (the full model: the dearest)
+  // (the full model: the dearest; with a target, at the largest n it may reach)
+  if (dynamic) check_run_cost(cs, model_of(cs, rq.accuracy ? rq.max_n : ro.ns.back()), joint_inputs(cs), c);
   const SignalStop signals(rq.stop);
   ProgressLine progress(quiet);
   rq.progress = [&](const Progress& p) { progress.show(p); };
@@ -77,6 +93,7 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
     progress.clear();
     if (quiet) return;
     if (!rq.modes.empty()) fmt::print(stderr, "[{}/{}] {}\n", i + 1, count, n ? fmt::format("modes = {}", n) : std::string("full model"));
+    else if (count == 0) fmt::print(stderr, "[{}] n = {} (towards --accuracy {:g})\n", i + 1, n, *rq.accuracy);
     else if (i < count) fmt::print(stderr, "[{}/{}] n = {}\n", i + 1, count, n);
     else fmt::print(stderr, "[check] n = {} at rtol {:g}\n", n, cs.sim.options.rtol / 100);
   };
@@ -84,7 +101,10 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
   progress.clear();
   for (size_t k = 0; k < qs.size(); ++k)  // warnings always reach stderr, with --json and --quiet too
     for (const auto& w : res.tables[k].warnings) print_warning(qs[k].text + ": " + w);
-  const int code = res.status.kind == RunStatus::Kind::Interrupted ? 128 + std::max(res.status.signal, 2) : 0;
+  // A target that was not met is not success (exit 3), after the tables.
+  const int code = res.status.kind == RunStatus::Kind::Interrupted ? 128 + std::max(res.status.signal, 2)
+                   : rq.accuracy && !res.met                         ? 3
+                                                                     : 0;
   if (c.json) {
     auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
     nlohmann::json jq = nlohmann::json::array();
@@ -97,13 +117,23 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
         else
           rows.push_back({{"modes", r.n}, {"value", r.value}, {"change", num(r.change)}});  // (0: the full model)
       jq.push_back({{"quantity", qs[k].text}, {"rows", rows}, {"fitted_order", num(res.tables[k].fitted_order)},
-                    {"integration_error", num(res.tables[k].integration_error)}, {"warnings", res.tables[k].warnings}});
+                    {"integration_error", num(res.tables[k].integration_error)}, {"error", num(res.tables[k].error)},
+                    {"error_space", num(res.tables[k].error_space)}, {"error_time", num(res.tables[k].error_time)},
+                    {"observed_order", num(res.tables[k].observed_order())}, {"asymptotic", res.tables[k].asymptotic},
+                    {"warnings", res.tables[k].warnings}});
     }
-    print_json({{"command", "refine"}, {"case", cs.path}, {"status", res.status.to_string()}, {"quantities", jq},
-                {"output", path}});
+    nlohmann::json out = {{"command", "refine"}, {"case", cs.path}, {"status", res.status.to_string()}, {"quantities", jq},
+                          {"output", path}};
+    if (rq.accuracy) out.update({{"accuracy", *rq.accuracy}, {"met", res.met}, {"shortfall", res.shortfall}});
+    print_json(out);
     return code;
   }
   print_tables(cs, res);
+  if (rq.accuracy && res.status.is_completed()) {
+    if (res.met) fmt::print("accuracy {:g}: met at n = {} by every quantity\n", *rq.accuracy, res.ns.back());
+    else fmt::print("accuracy {:g}: NOT met\n", *rq.accuracy);
+    for (const auto& line : res.shortfall) fmt::print("  {}\n", line);
+  }
   if (!path.empty())
     fmt::print("every run and the table in {}{}\n", path,
                res.status.is_completed() ? "" : " (" + res.status.to_string() + ")");

@@ -2,6 +2,7 @@
 // The rfem program's commands: each translates its options into a library call (studies/), prints
 // the result and returns the exit code. Bad input throws CaseError (exit 2), solver failures
 // std::runtime_error (exit 1).
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "../results/writer.hpp"
 #include "../simulation/common.hpp"
 #include "../solvers/inputs.hpp"
+#include "../studies/refine.hpp"
 #include "../studies/runs.hpp"
 #include "../studies/sweep.hpp"
 
@@ -43,6 +45,8 @@ struct RefineOptions {
   std::string output;                   ///< HDF5 file (default for dynamic quantities: CASE_refine.h5)
   bool integration_check = true;        ///< rerun the finest n at 100× tighter tolerances
   std::vector<int> modes;               ///< a series over link.modes at one n, against the full model
+  std::optional<double> accuracy;       ///< a relative target instead of a ladder (studies/refine.hpp)
+  int max_n = kMaxTargetN;
 };
 
 /// `rfem show`: the assembled tree of joints, links and bodies.

@@ -146,7 +146,10 @@ int main(int argc, char** argv) {
   auto* rf = app.add_subcommand("refine", "convergence tables of quantities over a series of n");
   add_common(rf, false);
   RefineOptions ro;
-  rf->add_option("--n", ro.ns, "the series of n, increasing: --n 6,12,24")->delimiter(',')->check(kRfes)->required();
+  rf->add_option("--n", ro.ns, "the series of n, increasing: --n 6,12,24 (with --accuracy: where it starts)")->delimiter(',')->check(kRfes);
+  rf->add_option("--accuracy", ro.accuracy,
+                 "a relative error bar every quantity must meet: n doubles (from --n, or 8) until it does or passes --max-n");
+  rf->add_option("--max-n", ro.max_n, "the largest n --accuracy may reach")->check(kRfes);
   rf->add_option("--quantity", ro.quantities,
                  "one or more (comma-separated, from the same runs): static tip:ux|uy|uz|rx|ry|rz; modes mode:K, "
                  "bending-y:K, bending-z:K, axial:K, torsion:K; dynamic [RUN/]peak:u1|u2|theta, [RUN/]u1@T, u2@T, "

@@ -476,7 +476,7 @@ PYBIND11_MODULE(_rfem, m) {
 
   m.def("_refine", [](args::Typed<"Union[Case, str, os.PathLike]"> case_arg, args::Typed<"List[int]"> ns, args::Typed<"List[str]"> quantity_args, args::Typed<"Optional[Union[str, os.PathLike]]"> output_arg,
                       args::Typed<"bool"> integration_check, args::Typed<"Optional[float]"> rate, args::Typed<"int"> joint, args::Typed<"int"> threads, args::Typed<"Optional[Callable[[dict], Any]]"> progress,
-                      args::Typed<"Optional[List[int]]"> modes) {
+                      args::Typed<"Optional[List[int]]"> modes, args::Typed<"Optional[float]"> accuracy, args::Typed<"Optional[int]"> max_n) {
     const args::CaseArg cs_arg(case_arg);
     const Case& cs = *cs_arg;
     const std::vector<std::string> quantities = args::texts(quantity_args, "quantities");
@@ -484,7 +484,9 @@ PYBIND11_MODULE(_rfem, m) {
     auto pending = std::make_shared<CallGuard>();
     pending->progress = args::callback(progress, "progress");
     RefineRequest rq;
-    rq.ns = args::rfes_list(ns, "ns");
+    if (!ns.is_none()) rq.ns = args::rfes_list(ns, "ns");
+    if (!accuracy.is_none()) rq.accuracy = args::real(accuracy, "accuracy", "a relative error between 0 and 1");
+    if (!max_n.is_none()) rq.max_n = args::rfes(max_n, "max_n");
     if (!modes.is_none()) rq.modes = args::rfes_list(modes, "modes");
     rq.quantities = quantities;
     rq.integration_check = args::flag(integration_check, "integration_check");
@@ -505,6 +507,11 @@ PYBIND11_MODULE(_rfem, m) {
     out["status"] = res.status.to_string();
     out["ns"] = res.ns;
     out["modes"] = res.modes;
+    if (rq.accuracy) {
+      out["accuracy"] = *rq.accuracy;
+      out["met"] = res.met;
+      out["shortfall"] = res.shortfall;
+    }
     py::list tables;
     for (size_t k = 0; k < res.tables.size(); ++k) {
       const Refinement& t = res.tables[k];
@@ -518,6 +525,11 @@ PYBIND11_MODULE(_rfem, m) {
         d[name] = py::array(py::cast(t.column(field)));
       d["fitted_order"] = t.fitted_order;
       d["integration_error"] = t.integration_error;
+      d["error"] = t.error;
+      d["error_space"] = t.error_space;
+      d["error_time"] = t.error_time;
+      d["observed_order"] = t.observed_order();
+      d["asymptotic"] = t.asymptotic;
       d["reference"] = t.reference();
       d["warnings"] = t.warnings;
       tables.append(d);
@@ -527,7 +539,8 @@ PYBIND11_MODULE(_rfem, m) {
     py::object error = pending->take();
     return py::make_tuple(out, error);
   }, py::arg("case"), py::arg("ns"), py::arg("quantities"), py::arg("output"), py::arg("integration_check"),
-     py::arg("rate"), py::arg("joint"), py::arg("threads"), py::arg("progress"), py::arg("modes"));
+     py::arg("rate"), py::arg("joint"), py::arg("threads"), py::arg("progress"), py::arg("modes"), py::arg("accuracy"),
+     py::arg("max_n"));
   bind_sweep(m);
   bind_simulation(m);
 }

@@ -174,6 +174,12 @@ void ResultsWriter::write_refinement(const std::vector<std::string>& quantities,
       h5::write_attribute(where, "quantity", quantities[k]);
       h5::write_attribute(where, "fitted_order", t.fitted_order);
       h5::write_attribute(where, "integration_error", t.integration_error);
+      // The last value's error bar (solvers/refinement.hpp; NaN and asymptotic 0 where there is none).
+      h5::write_attribute(where, "error", t.error);
+      h5::write_attribute(where, "error_space", t.error_space);
+      h5::write_attribute(where, "error_time", t.error_time);
+      h5::write_attribute(where, "observed_order", t.observed_order());
+      h5::write_attribute(where, "asymptotic", static_cast<long>(t.asymptotic));
       std::string w;
       for (const auto& x : t.warnings) w += (w.empty() ? "" : "\n") + x;
       h5::write_attribute(where, "warnings", w);
@@ -217,6 +223,14 @@ void ResultsWriter::write_attribute(const std::string& object, const std::string
   f.end_swmr();
   const h5::Handle obj = h5::object(H5Oopen(f.id, object.c_str(), H5P_DEFAULT), f.what("opening " + object));
   h5::write_attribute(obj, key, values);
+}
+
+void ResultsWriter::write_attribute(const std::string& object, const std::string& key, double value) {
+  const h5::Quiet quiet;
+  File& f = *file_;
+  f.end_swmr();
+  const h5::Handle obj = h5::object(H5Oopen(f.id, object.c_str(), H5P_DEFAULT), f.what("opening " + object));
+  h5::write_attribute(obj, key, value);
 }
 
 void ResultsWriter::write_external_link(const std::string& name, const std::string& file, const std::string& object) {

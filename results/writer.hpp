@@ -88,6 +88,7 @@ class ResultsWriter {
   /// String attributes of an object ("/", "modes").
   void write_attribute(const std::string& object, const std::string& key, const std::string& value);
   void write_attribute(const std::string& object, const std::string& key, const std::vector<std::string>& values);
+  void write_attribute(const std::string& object, const std::string& key, double value);
   /// A link `name` to `object` in another HDF5 file (`file` relative to this one's directory or
   /// absolute): h5py follows it as a group of this file.
   void write_external_link(const std::string& name, const std::string& file, const std::string& object);

@@ -63,13 +63,27 @@ Refinement assess_refinement(const std::vector<int>& ns, const std::vector<doubl
                          num(integration_error) + "): tighten simulation.rtol");
     trust = false;
   }
-  if (!trust) return r;  // no extrapolated values from a series that cannot be trusted
+  if (!trust) return r;  // no extrapolated values, no error bar from a series that cannot be trusted
   for (size_t i = 2; i < m; ++i) {
     const double p = r.rows[i].order;
     if (!std::isfinite(p)) continue;
     const double q = std::pow(double(ns[i]) / ns[i - 1], p);
     r.rows[i].richardson = values[i] + r.rows[i].change / (q - 1.0);
   }
+  if (!std::isfinite(p1)) return r;
+  if (p1 < 1.0 || p1 > 4.0) {
+    r.warnings.push_back("the observed order " + num(p1) + " is far from the theoretical " + num(kTheoreticalOrder) +
+                         ": no error bar (refine further, or from a larger first n)");
+    return r;
+  }
+  // Roache's GCI over the last two n: the order no higher than the theoretical one (a bar never
+  // shrinks for an order that looks better than the method has), Fs by how near the order is.
+  r.safety_factor = std::abs(p1 - kTheoreticalOrder) <= 0.25 ? 1.25 : 3.0;
+  const double ratio = double(ns[m - 1]) / ns[m - 2];
+  r.error_space = r.safety_factor * last / (std::pow(ratio, std::min(p1, kTheoreticalOrder)) - 1.0);
+  r.error_time = integration_error;
+  r.error = r.error_space + (std::isfinite(integration_error) ? integration_error : 0.0);
+  r.asymptotic = true;
   return r;
 }
 

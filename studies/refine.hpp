@@ -7,6 +7,7 @@
 // every flexible link reduced to m modes (link.modes = m, README "Reduced links") for each m, and
 // the full model, each row's change its distance from the full model's value.
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,12 +17,21 @@
 
 namespace rfem {
 
+/// Where a study with a target starts without a given n, and the largest n it may reach by default.
+inline constexpr int kFirstTargetN = 8;
+inline constexpr int kMaxTargetN = 2048;
+
 struct RefineRequest {
   std::vector<int> ns;                  ///< strictly increasing, at least two (one with `modes`)
   /// A series over modes instead of n (strictly increasing, each ≥ 1): rows m …, then 0 (the full model).
   std::vector<int> modes;
   std::vector<std::string> quantities;  ///< at least one (studies/quantities.hpp)
   bool integration_check = true;        ///< rerun the finest n at 100× tighter tolerances
+  /// A target instead of a ladder (> 0): the relative error bar every quantity's value must meet
+  /// (Refinement::error ≤ accuracy·|value|). The series doubles n from the last of `ns` (from
+  /// kFirstTargetN without one) until every bar meets it, or the next n would pass max_n.
+  std::optional<double> accuracy;
+  int max_n = kMaxTargetN;
   JointRate rate;                       ///< for static and modal quantities
   int threads = 0;
   StopToken stop;                       ///< ends the study after the current run; rows done are kept
@@ -42,6 +52,10 @@ struct RefineResult {
   std::vector<int> modes;              ///< the m of the rows (0: the full model); empty for a series over n
   RunStatus status;                    ///< completed, or interrupted
   bool dynamic = false;                ///< some quantity needed runs
+  /// With a target (RefineRequest::accuracy): whether every bar met it, and if not, per quantity
+  /// that did not, why and by how much (one line each: not success).
+  bool met = false;
+  std::vector<std::string> shortfall;
 };
 
 /// Checks every quantity and every n before the first run (CaseError), then runs the study.

@@ -7,7 +7,8 @@ trap 'rm -rf "$dir"' EXIT
 cd "$dir"
 # `rfem plot` calls the package's entry point (rfem.plots:main) inside the program; a build without
 # Python (the sanitizer build) has only the entry point itself, run by python3.
-if "$rfem" plot /dev/null 2>&1 | grep -q "built without Python"; then
+probe=$("$rfem" plot /dev/null 2>&1 || true)  # (exit 2 either way: /dev/null is no results file)
+if [[ $probe == *"built without Python"* ]]; then
   rfem_plot() { /usr/bin/python3 -P -m rfem.plots "$@"; }
 else
   rfem_plot() { "$rfem" plot "$@"; }

@@ -57,4 +57,19 @@ sys.exit(0 if ok else 1)
 PY
 grep -q "^     8 " part.txt || { echo "FAIL: partial table not printed"; exit 1; }
 rfem_plot part.h5 -o figs2 >/dev/null
+# A target (docs/accuracy.md): a bad one is one line, exit 2, no file; one that is not met up to
+# --max-n says so in the file too (attributes accuracy, met, shortfall) and exits 3.
+for bad in 0 nan 1 -1e-3; do
+  set +e; err=$("$rfem" refine "$src/cases/kane_beam.toml" --quantity mode:1 --accuracy "$bad" -o bad.h5 2>&1 >/dev/null); code=$?; set -e
+  [ "$code" = 2 ] && [ "$(printf '%s\n' "$err" | wc -l)" = 1 ] && [ ! -e bad.h5 ] || { echo "FAIL --accuracy $bad: exit $code: $err"; exit 1; }
+done
+set +e; "$rfem" refine "$src/cases/kane_beam.toml" --quantity mode:1 --accuracy 1e-9 --max-n 32 -o short.h5 -q >/dev/null; code=$?; set -e
+[ "$code" = 3 ] || { echo "FAIL: a target not met exits $code (want 3)"; exit 1; }
+/usr/bin/python3 - <<'PY'
+import sys, h5py
+g = h5py.File("short.h5", "r")["refine"]
+ok = g.attrs["accuracy"] == 1e-9 and g.attrs["met"] == 0 and "n ≈" in str(g.attrs["shortfall"]) and g.attrs["asymptotic"] == 1
+print(("ok  " if ok else "FAIL"), "a target not met is in the file:", dict(g.attrs))
+sys.exit(0 if ok else 1)
+PY
 echo "refine: all passed"

@@ -264,7 +264,11 @@ def modes(case, n=None, count=6, free=(), rate=None, joint=1, output=None):
 class RefineResult(dict):
     """A refinement study: ["status"], ["ns"], and per quantity ["tables"][k] with "quantity",
     "n", "value", "change", "order", "richardson" (arrays), "fitted_order",
-    "integration_error", "reference" and "warnings"; table("peak:u1") finds one by name."""
+    "integration_error", "reference", "warnings" and the error bar of the last value, value[-1]:
+    "error" = "error_space" (Roache's grid convergence index) + "error_time" (the integration
+    check; 0 for static and modal values), "observed_order" and "asymptotic" (False, and the bar
+    NaN, where the series does not show the asymptotic range: no bar rather than a false one);
+    table("peak:u1") finds one by name."""
 
     def table(self, quantity):
         for t in self["tables"]:
@@ -278,15 +282,19 @@ class RefineResult(dict):
 
 
 def refine(case, ns, quantities, output=None, integration_check=True, rate=None, joint=1, threads=0, progress=None,
-           modes=None):
+           modes=None, accuracy=None, max_n=None):
     """Quantities over an increasing series of n with observed orders and Richardson values
     (the quantities of `rfem refine`: "tip:uz", "bending-y:1", "peak:u1", "force/u1@10", …).
     Dynamic quantities share one run per n; `output` keeps every run and the tables in HDF5.
     modes=[4, 8, 16] (`rfem refine --modes`): a series over modes instead, at the one n of `ns`:
     every flexible link reduced to m modes, then the full model; each table's "modes" (0: full),
-    "value" and "change" (value − the full model's). Ctrl-C raises RunInterrupted with the rows
-    done in .result."""
-    out, error = _rfem._refine(case, ns, quantities, output, integration_check, rate, joint, threads, progress, modes)
+    "value" and "change" (value − the full model's). accuracy=1e-3 (`rfem refine --accuracy`): a
+    relative error bar every quantity must meet instead of a fixed series: n doubles from the last
+    of `ns` (or 8, with ns=None) until every table's "error" ≤ accuracy·|value[-1]| or the next n
+    passes max_n (2048); ["met"] says whether it was, ["shortfall"] why not and by how much.
+    Ctrl-C raises RunInterrupted with the rows done in .result."""
+    out, error = _rfem._refine(case, ns, quantities, output, integration_check, rate, joint, threads, progress, modes,
+                               accuracy, max_n)
     result = RefineResult(out)
     _raise(error, result)
     return result

@@ -83,6 +83,22 @@ def test_static_modes_refine_equal_program():
         assert [r["value"] for r in q["rows"]] == list(ref.table(q["quantity"])["value"])
     # the static tip converges with order 2 (docs/formulation.md §7.5)
     assert abs(ref.table("tip:uz")["order"][-1] - 2.0) < 0.05
+    # and each table carries its last value's error bar, the program's (docs/accuracy.md)
+    for q in js["quantities"]:
+        t = ref.table(q["quantity"])
+        assert t["asymptotic"] and q["asymptotic"] and t["error"] == q["error"] and t["error_time"] == 0.0
+    # An accuracy instead of a series: the program's choice of n and bars; a target that cannot be
+    # met up to max_n is not met (exit 3 in the program), with how far it falls short.
+    code, out, err = program("refine", case_path("kane_beam.toml"), "--quantity", "mode:1", "--accuracy", "1e-4", "--json")
+    js = json.loads(out)
+    acc = rfem.refine(rfem.load(case_path("kane_beam.toml")), None, ["mode:1"], accuracy=1e-4)
+    assert code == 0 and js["met"] and acc["met"]
+    assert [r["n"] for r in js["quantities"][0]["rows"]] == list(acc["ns"]) and acc["ns"][0] == 8
+    assert acc["tables"][0]["error"] <= 1e-4 * acc["tables"][0]["value"][-1]
+    code, out, err = program("refine", case_path("kane_beam.toml"), "--quantity", "mode:1", "--accuracy", "1e-9", "--max-n", "32")
+    assert code == 3 and "NOT met" in out and "n ≈" in out
+    short = rfem.refine(rfem.load(case_path("kane_beam.toml")), None, ["mode:1"], accuracy=1e-9, max_n=32)
+    assert not short["met"] and len(short["shortfall"]) == 1
 
 
 @pytest.mark.parametrize("bad", ["14_negative_E.toml", "85_unknown_parent.toml", "51_unknown_input_kind.toml",
