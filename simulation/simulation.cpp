@@ -89,7 +89,6 @@ struct Simulation::Impl {
   std::vector<PendingTable> tables;
 
   void init(const Case& c, const std::string& name, const Checkpoint* checkpoint);
-  void start_from_state(const SimulationState& from);
 
   int joint(const std::string& name) const {
     for (int j = 0; j < model->m(); ++j)
