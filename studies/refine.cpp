@@ -65,7 +65,7 @@ bool evaluate_point(const Case& c, int n, const std::vector<JointInput>& inputs,
 bool meets(const std::vector<int>& ns, const std::vector<std::vector<double>>& values, const std::vector<double>& time,
            double target) {
   for (size_t k = 0; k < values.size(); ++k) {
-    const Refinement r = assess_refinement(ns, values[k], std::isnan(time[k]) ? NAN : 0.0);
+    const Refinement r = assess_refinement(ns, values[k], time[k]);
     if (!r.asymptotic || !(r.error <= target * std::abs(values[k].back()))) return false;
   }
   return true;
