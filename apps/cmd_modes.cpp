@@ -2,6 +2,8 @@
 #include <fmt/core.h>
 #include <fmt/ranges.h>
 
+#include <optional>
+
 #include "commands.hpp"
 #include "../results/errors.hpp"
 #include "../studies/run_file.hpp"
@@ -15,6 +17,19 @@ int run_modes(const Common& c, const ModesOptions& o) {
   rq.count = o.count;
   rq.rate = o.rate;
   rq.free = o.free;
+  // A target: n from a refinement of the frequencies (studies/accuracy.hpp), then the modes there.
+  const AccuracySpec target = accuracy_target(cs, c);
+  std::optional<AccuracyResult> acc;
+  if (target.given()) {
+    if (!o.free.empty()) throw CaseError("--accuracy: modes with --free joints are not refined yet; give --n");
+    RefineRequest base;
+    base.rate = o.rate;
+    base.threads = c.threads;
+    base.warn = print_warning;
+    base.on_n = ladder_lines(target, c.json || c.quiet);
+    acc = meet_accuracy(cs, target, reported_by_modes(o.count), base);
+    rq.n = acc->n;
+  }
   ModesStudy s;
   try {
     s = modes_into_file(cs, rq, o.output, c.command_line, max_threads(c));
@@ -64,9 +79,16 @@ int run_modes(const Common& c, const ModesOptions& o) {
   if (!c.json && s.has_reference)
     fmt::print("reference: (T) Timoshenko cantilever (shear and rotary inertia), (rod) rod theory; the error is "
                "the discretisation's and falls as 1/n²\n");
-  if (c.json) print_json({{"command", "modes"}, {"case", cs.path}, {"n", model.n()}, {"solver", r.dense ? "dense" : "lanczos"},
-                          {"free_joints", s.free_names}, {"modes", modes}});
-  return 0;
+  if (acc && !o.output.empty()) write_accuracy(o.output, *acc);
+  if (c.json) {
+    nlohmann::json out = {{"command", "modes"}, {"case", cs.path}, {"n", model.n()}, {"solver", r.dense ? "dense" : "lanczos"},
+                          {"free_joints", s.free_names}, {"modes", modes}};
+    if (acc) out["accuracy"] = accuracy_json(*acc);
+    print_json(out);
+  } else if (acc) {
+    print_accuracy(*acc);
+  }
+  return acc && !acc->met ? 3 : 0;  // (a target that was not met is not success)
 }
 
 }  // namespace rfem::app

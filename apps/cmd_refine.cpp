@@ -67,13 +67,15 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
   rq.modes = ro.modes;
   rq.quantities = ro.quantities;
   rq.integration_check = ro.integration_check;
-  rq.accuracy = ro.accuracy;  // (unset without --accuracy)
-  rq.max_n = ro.max_n;
   rq.rate = o.rate;
+  // A target: --accuracy, or the case's [accuracy] for a study without a ladder of its own.
+  const AccuracySpec target = accuracy_target(cs, c, true);
+  const bool targeted = target.given() && (!c.accuracy.empty() || (ro.modes.empty() && ro.ns.size() < 2));
+  if (targeted) apply_target(cs, target, rq);
   rq.threads = c.threads;
   rq.warn = print_warning;
   // Every quantity and every n are checked before the first run (and before the file is made).
-  const std::vector<Quantity> qs = check_refinement(cs, rq);
+  const std::vector<Quantity> qs = check_refinement(cs, rq);  // (with any quantity a target added)
   const bool dynamic = std::any_of(qs.begin(), qs.end(), [](const Quantity& q) { return q.dynamic(); });
   std::string path;  // (a study with runs keeps them in a file, by default beside the case's name)
   if (dynamic || !ro.output.empty()) {
@@ -85,17 +87,19 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
   }
   const bool quiet = c.json || c.quiet;
   // (the full model: the dearest; with a target, at the largest n it may reach)
-  if (dynamic) check_run_cost(cs, model_of(cs, rq.accuracy ? rq.max_n : ro.ns.back()), joint_inputs(cs), c);
+  if (dynamic) check_run_cost(cs, model_of(cs, targeted ? rq.max_n : ro.ns.back()), joint_inputs(cs), c);
   const SignalStop signals(rq.stop);
   ProgressLine progress(quiet);
   rq.progress = [&](const Progress& p) { progress.show(p); };
+  const auto ladder = ladder_lines(target, false);
   rq.on_n = [&](int i, int count, int n) {
     progress.clear();
     if (quiet) return;
     if (!rq.modes.empty()) fmt::print(stderr, "[{}/{}] {}\n", i + 1, count, n ? fmt::format("modes = {}", n) : std::string("full model"));
-    else if (count == 0) fmt::print(stderr, "[{}] n = {} (towards --accuracy {:g})\n", i + 1, n, *rq.accuracy);
+    else if (count == 0 || i < 0) ladder(i, count, n);
     else if (i < count) fmt::print(stderr, "[{}/{}] n = {}\n", i + 1, count, n);
-    else fmt::print(stderr, "[check] n = {} at rtol {:g}\n", n, cs.sim.options.rtol / 100);
+    else fmt::print(stderr, "[check] n = {} at rtol {:g}\n", n,
+                    (targeted && rq.accuracy ? tolerances_for_target(cs.sim.options, *rq.accuracy) : cs.sim.options).rtol / 100);
   };
   const RefineResult res = path.empty() ? refine(cs, rq) : refine_into_file(cs, rq, path, c.command_line);
   progress.clear();
@@ -103,7 +107,7 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
     for (const auto& w : res.tables[k].warnings) print_warning(qs[k].text + ": " + w);
   // A target that was not met is not success (exit 3), after the tables.
   const int code = res.status.kind == RunStatus::Kind::Interrupted ? 128 + std::max(res.status.signal, 2)
-                   : rq.accuracy && !res.met                         ? 3
+                   : targeted && !res.met                            ? 3
                                                                      : 0;
   if (c.json) {
     auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
@@ -124,14 +128,22 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
     }
     nlohmann::json out = {{"command", "refine"}, {"case", cs.path}, {"status", res.status.to_string()}, {"quantities", jq},
                           {"output", path}};
-    if (rq.accuracy) out.update({{"accuracy", *rq.accuracy}, {"met", res.met}, {"shortfall", res.shortfall}});
+    if (targeted) {
+      nlohmann::json allowed = nlohmann::json::array();
+      for (double a : res.allowed) allowed.push_back(num(a));
+      out.update({{"accuracy", num(rq.accuracy ? *rq.accuracy : NAN)}, {"met", res.met}, {"shortfall", res.shortfall},
+                  {"allowed", allowed}, {"rtol", num(res.dynamic ? res.rtol : NAN)},
+                  {"atol", num(res.dynamic ? res.atol : NAN)}, {"calibration", res.calibration}});
+    }
     print_json(out);
     return code;
   }
   print_tables(cs, res);
-  if (rq.accuracy && res.status.is_completed()) {
-    if (res.met) fmt::print("accuracy {:g}: met at n = {} by every quantity\n", *rq.accuracy, res.ns.back());
-    else fmt::print("accuracy {:g}: NOT met\n", *rq.accuracy);
+  if (targeted && res.status.is_completed()) {
+    const std::string what = rq.accuracy ? fmt::format("accuracy {:g}", *rq.accuracy) : std::string("the absolute targets");
+    const std::string tol = res.dynamic ? fmt::format(" (rtol {:g}, atol {:g})", res.rtol, res.atol) : std::string();
+    if (res.met) fmt::print("{}: met at n = {}{} by every quantity\n", what, res.ns.back(), tol);
+    else fmt::print("{}: NOT met{}\n", what, tol);
     for (const auto& line : res.shortfall) fmt::print("  {}\n", line);
   }
   if (!path.empty())

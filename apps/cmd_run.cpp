@@ -2,6 +2,8 @@
 #include <fmt/core.h>
 #include <spdlog/spdlog.h>
 
+#include <optional>
+
 #include "../simulation/inputs.hpp"
 #include "../simulation/recorders.hpp"
 #include "../studies/resume.hpp"
@@ -72,7 +74,7 @@ struct Console {
 
 // The runs' summaries as JSON or text after the runs, and the exit code of the last run.
 int report(const std::string& case_path, long n, const std::string& output, const std::vector<RunResult>& runs,
-           const std::vector<std::string>& xdmf, const Common& c, bool quiet) {
+           const std::vector<std::string>& xdmf, const Common& c, bool quiet, const nlohmann::json& accuracy = nullptr) {
   if (c.json) {
     nlohmann::json js = nlohmann::json::array();
     for (const auto& r : runs) {
@@ -87,7 +89,9 @@ int report(const std::string& case_path, long n, const std::string& output, cons
       if (!r.peaks.empty())  // the last link's, as with one link
         js.back().update({{"peak_u1", r.peaks.back().u1}, {"peak_u2", r.peaks.back().u2}, {"peak_theta", r.peaks.back().theta}});
     }
-    print_json({{"command", "run"}, {"case", case_path}, {"n", n}, {"output", output}, {"xdmf", xdmf}, {"runs", js}});
+    nlohmann::json out = {{"command", "run"}, {"case", case_path}, {"n", n}, {"output", output}, {"xdmf", xdmf}, {"runs", js}};
+    if (!accuracy.is_null()) out["accuracy"] = accuracy;
+    print_json(out);
   } else if (!quiet) {
     fmt::print("results in {}\n", output);
     for (const std::string& x : xdmf) fmt::print("ParaView: {}\n", x);
@@ -123,26 +127,64 @@ int resume_simulation(const Common& c, const RunOptions& o) {
   return report(plan.cs.path, runs.empty() ? -1 : runs.back().model->n(), o.resume, runs, xdmf, c, quiet);
 }
 
+// A target (--accuracy, [accuracy]): the tolerances and n from a refinement of the peaks the run
+// reports (studies/accuracy.hpp); nothing if the caller gives none.
+std::optional<AccuracyResult> choose_by_target(const Case& cs, const AccuracySpec& target, const Common& c, RunRequest& rq,
+                                               Console& console, bool quiet) {
+  if (!target.given()) return std::nullopt;
+  const Reported reported = reported_by_run(cs);
+  RefineRequest base;
+  base.threads = c.threads;
+  base.warn = print_warning;
+  base.stop = rq.stop;
+  base.progress = rq.progress;
+  const auto lines = ladder_lines(target, quiet);
+  base.on_n = [&](int i, int count, int n) {
+    console.progress.clear();
+    if (lines) lines(i, count, n);
+  };
+  AccuracyResult a = meet_accuracy(cs, target, reported, base);
+  console.progress.clear();
+  rq.n = a.n;
+  return a;
+}
+
 }  // namespace
 
 int run_simulation(const Common& c, const RunOptions& o) {
   if (!o.resume.empty()) return resume_simulation(c, o);
-  const Case cs = read_checked_case(c);
+  const Case given = read_checked_case(c);
+  const AccuracySpec target = accuracy_target(given, c);
   const bool quiet = c.json || c.quiet;
   RunRequest rq;
   rq.n = c.n;
   const SignalStop signals(rq.stop);
   Console console(quiet);
   console.attach(rq, c, o);
+  const std::optional<AccuracyResult> acc = choose_by_target(given, target, c, rq, console, quiet);
+  if (acc && !acc->refinement.status.is_completed()) {  // (stopped by a signal during the ladder)
+    fmt::print(stderr, "rfem: the search for n towards the target was {}\n", acc->refinement.status.to_string());
+    return 128 + std::max(acc->refinement.status.signal, 2);
+  }
+  const Case cs = acc ? at_chosen_tolerances(given, *acc) : given;
   const FileRuns f = run_into_file(cs, rq, o.output, c.command_line, [&](const std::shared_ptr<const Model>& mp, const std::vector<JointInput>& inputs) {
     check_run_cost(cs, mp, inputs, c);
     const Model& model = *mp;
     if (!quiet)
-      fmt::print("rfem run {}: n = {} rfes{}, m = {} joints, t_end = {} s, {} thread(s) -> {}\n", cs.path, model.n(),
+      fmt::print("rfem run {}: n = {} rfes{}, m = {} joints, t_end = {} s, {} thread(s){} -> {}\n", cs.path, model.n(),
                  model.links.size() > 1 ? fmt::format(" in {} links", model.links.size()) : "", model.m(),
-                 cs.sim.options.t_end, max_threads(c), o.output);
+                 cs.sim.options.t_end, max_threads(c),
+                 acc ? fmt::format(", rtol {:g}, atol {:g} (chosen for the target)", cs.sim.options.rtol, cs.sim.options.atol) : "",
+                 o.output);
   });
-  return report(cs.path, f.model->n(), o.output, f.runs, f.views, c, quiet);
+  const bool completed = !f.runs.empty() && f.runs.back().completed();
+  if (acc && completed) {
+    write_accuracy(o.output, *acc);
+    if (!c.json) print_accuracy(*acc);  // (results: also with -q)
+  }
+  const int code = report(cs.path, f.model->n(), o.output, f.runs, f.views, c, quiet,
+                          acc && completed ? accuracy_json(*acc) : nlohmann::json(nullptr));
+  return code == 0 && acc && !acc->met ? 3 : code;  // (a target that was not met is not success)
 }
 
 }  // namespace rfem::app

@@ -2,6 +2,7 @@
 // The rfem program's commands: each translates its options into a library call (studies/), prints
 // the result and returns the exit code. Bad input throws CaseError (exit 2), solver failures
 // std::runtime_error (exit 1).
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "../results/writer.hpp"
 #include "../simulation/common.hpp"
 #include "../solvers/inputs.hpp"
+#include "../studies/accuracy.hpp"
 #include "../studies/refine.hpp"
 #include "../studies/runs.hpp"
 #include "../studies/sweep.hpp"
@@ -28,6 +30,9 @@ struct Common {
   bool quiet = false;    ///< no progress line and no summary (results only)
   bool verbose = false;  ///< log solver events
   int threads = 0;       ///< --threads (0: each run chooses)
+  /// --accuracy (repeatable): a relative target ("1e-3") or QUANTITY=ERROR; replaces the case's [accuracy].
+  std::vector<std::string> accuracy;
+  int max_n = 0;         ///< --max-n (0: the target's, else kMaxTargetN)
 };
 
 struct ModesOptions {
@@ -45,8 +50,6 @@ struct RefineOptions {
   std::string output;                   ///< HDF5 file (default for dynamic quantities: CASE_refine.h5)
   bool integration_check = true;        ///< rerun the finest n at 100× tighter tolerances
   std::vector<int> modes;               ///< a series over link.modes at one n, against the full model
-  std::optional<double> accuracy;       ///< a relative target instead of a ladder (studies/refine.hpp)
-  int max_n = kMaxTargetN;
 };
 
 /// `rfem show`: the assembled tree of joints, links and bodies.
@@ -102,6 +105,15 @@ Case read_checked_case(const Common& c);
 /// Refuses a run the machine's memory cannot hold (CaseError); before a run of kLargeRunRfes rfes
 /// or more prints its memory and the timed cost of a step (unless quiet).
 void check_run_cost(const Case& cs, std::shared_ptr<const Model> model, const std::vector<JointInput>& inputs, const Common& c);
+/// A command's target: --accuracy (replacing the case's [accuracy]) and --max-n, else the case's
+/// [accuracy] unless --n is given; none if neither (AccuracySpec::given()). CaseError for --n with
+/// --accuracy, unless --n is where the ladder starts (`n_starts_ladder`: rfem refine).
+AccuracySpec accuracy_target(const Case& cs, const Common& c, bool n_starts_ladder = false);
+/// The ladder's lines on stderr (RefineRequest::on_n; none when quiet).
+std::function<void(int, int, int)> ladder_lines(const AccuracySpec& spec, bool quiet);
+/// The estimates as a table, and whether the target was met (stdout).
+void print_accuracy(const AccuracyResult& a);
+nlohmann::json accuracy_json(const AccuracyResult& a);
 /// The largest thread team a run may use (--threads, else OpenMP's default).
 int max_threads(const Common& c);
 

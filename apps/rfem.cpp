@@ -77,6 +77,15 @@ int main(int argc, char** argv) {
     sub->add_flag("-q,--quiet", common.quiet, "no progress line or summary");
     sub->add_flag("-v,--verbose", common.verbose, "log solver events to stderr");
   };
+  // A target instead of an n (studies/accuracy.hpp): run, modes, static, refine.
+  auto add_accuracy = [&](CLI::App* sub) {
+    sub->add_option("--accuracy", common.accuracy,
+                    "a target instead of an n: a relative error bar every reported value must meet (1e-3), or "
+                    "QUANTITY=ERROR for one value (peak:u1=2e-4); repeatable; rfem chooses n and the tolerances")
+        ->delimiter(',');
+    sub->add_option("--max-n", common.max_n, fmt::format("the largest n a target may reach (default {})", rfem::kMaxTargetN))
+        ->check(kRfes);
+  };
   ModesOptions mo;
   auto add_rate = [&](CLI::App* sub) {
     sub->add_option("--rate", mo.rate.rate, "steady rate of the chosen joint [rad/s or m/s]")->each([&](const std::string&) {
@@ -89,9 +98,11 @@ int main(int argc, char** argv) {
   add_common(sh, true);
   auto* st = app.add_subcommand("static", "static equilibrium under gravity and tip loads, joints held (or turning steadily: --rate)");
   add_common(st, true);
+  add_accuracy(st);
   add_rate(st);
   auto* md = app.add_subcommand("modes", "natural frequencies and mode shapes of the flexible link, base held or joints free");
   add_common(md, true);
+  add_accuracy(md);
   md->add_option("--count", mo.count, "number of modes (at most 6n + free joints)")->check(kPositiveInt);
   md->add_option("-o,--output", mo.output, "HDF5 file for the frequencies and mode shapes (group modes)");
   md->add_option("--free", mo.free, "joints that move with the modes: numbers from 1, names, or 'base' (a free base's six)")
@@ -99,6 +110,7 @@ int main(int argc, char** argv) {
   add_rate(md);
   auto* rn = app.add_subcommand("run", "time integration of the case's [simulation]; results to HDF5");
   add_common(rn, true);
+  add_accuracy(rn);
   RunOptions run_options;
   run_options.checkpoint = rfem::kCheckpointInterval;
   rn->add_option("-o,--output", run_options.output, "results file (default: the case name with .h5, here)");
@@ -109,7 +121,8 @@ int main(int argc, char** argv) {
       ->excludes(rn->get_option("case"))
       ->excludes(rn->get_option("--set"))
       ->excludes(rn->get_option("--n"))
-      ->excludes(rn->get_option("-o"));
+      ->excludes(rn->get_option("-o"))
+      ->excludes(rn->get_option("--accuracy"));
   rn->add_option("--checkpoint", run_options.checkpoint,
                  fmt::format("seconds of wall time between checkpoints (0: none; default {:g})", rfem::kCheckpointInterval))
       ->check(kNonNegativeFinite);
@@ -147,9 +160,7 @@ int main(int argc, char** argv) {
   add_common(rf, false);
   RefineOptions ro;
   rf->add_option("--n", ro.ns, "the series of n, increasing: --n 6,12,24 (with --accuracy: where it starts)")->delimiter(',')->check(kRfes);
-  rf->add_option("--accuracy", ro.accuracy,
-                 "a relative error bar every quantity must meet: n doubles (from --n, or 8) until it does or passes --max-n");
-  rf->add_option("--max-n", ro.max_n, "the largest n --accuracy may reach")->check(kRfes);
+  add_accuracy(rf);
   rf->add_option("--quantity", ro.quantities,
                  "one or more (comma-separated, from the same runs): static tip:ux|uy|uz|rx|ry|rz; modes mode:K, "
                  "bending-y:K, bending-z:K, axial:K, torsion:K; dynamic [RUN/]peak:u1|u2|theta, [RUN/]u1@T, u2@T, "

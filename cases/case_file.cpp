@@ -146,6 +146,34 @@ SimulationSettings read_simulation(const Reader& r, const toml::table& t) {
   return s;
 }
 
+// [accuracy]: relative = 1e-3, max_n = N, [accuracy.absolute] "peak:u1" = 2e-4 (cases/accuracy_spec.hpp).
+AccuracySpec read_accuracy(const Reader& r, const toml::node* an, const std::string& path) {
+  if (!an->is_table()) r.fail(an, "accuracy", "must be a table (relative = 1e-3, max_n, [accuracy.absolute])");
+  const toml::table& t = *an->as_table();
+  r.check_keys(t, "accuracy", {"relative", "max_n", "absolute"});
+  AccuracySpec a;
+  auto where = [&](const toml::node* n, const std::string& key) {
+    return path + (n && n->source().begin.line > 0 ? ":" + std::to_string(n->source().begin.line) : std::string()) + ": " + key;
+  };
+  if (const toml::node* n = t.get("relative")) {
+    const double v = r.number(t, "accuracy", "relative");
+    check_relative_target(v, where(n, "accuracy.relative"));
+    a.relative = v;
+  }
+  a.max_n = static_cast<int>(r.integer(t, "accuracy", "max_n", 0, 2, kMaxRfes));
+  if (const toml::node* n = t.get("absolute")) {
+    if (!n->is_table()) r.fail(n, "accuracy.absolute", "must be a table of QUANTITY = ERROR, e.g. \"peak:u1\" = 2e-4");
+    for (const auto& [k, v] : *n->as_table()) {
+      const std::string key = "accuracy.absolute." + std::string(k.str());
+      const double e = r.number(*n->as_table(), "accuracy.absolute", std::string(k.str()));
+      if (!(e > 0.0)) r.fail(&v, key, "an absolute error bar must be positive (got " + Reader::fmt(e) + ")");
+      a.absolute.push_back({std::string(k.str()), e, where(&v, key)});
+    }
+  }
+  if (!a.given()) r.fail(an, "accuracy", "gives no target: relative = 1e-3, or [accuracy.absolute] \"peak:u1\" = 2e-4");
+  return a;
+}
+
 // [base] kind = "free": six joints (free_base_joints) ahead of [[joints]], torque-free, starting
 
 }  // namespace
@@ -181,7 +209,7 @@ Case parse_case(const std::string& text, const std::string& path, const std::vec
     c.effective_text = os.str();
   }
   Reader r(path);
-  r.check_keys(root, "", {"case", "materials", "sections", "link", "links", "joints", "gravity", "loads", "simulation", "base", "sensors"});
+  r.check_keys(root, "", {"case", "materials", "sections", "link", "links", "joints", "gravity", "loads", "simulation", "base", "sensors", "accuracy"});
   const std::string& case_dir = c.base_dir;
 
   if (const toml::node* n = root.get("case")) {
@@ -242,6 +270,7 @@ Case parse_case(const std::string& text, const std::string& path, const std::vec
       if (c.loads.link < 0) r.fail(lt.get("link"), "loads.link", "no link named '" + name + "'");
     }
   }
+  if (const toml::node* an = root.get("accuracy")) c.accuracy = read_accuracy(r, an, path);
   for (const std::string& k : r.unused_accepts())
     r.warn(root.get("case"), "case.accept", "'" + k + "' draws no warning here: nothing to acknowledge");
   c.warnings = r.warnings();

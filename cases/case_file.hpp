@@ -13,6 +13,7 @@
 #include "../core/model.hpp"
 #include "../solvers/integrator.hpp"
 #include "../solvers/statics.hpp"
+#include "accuracy_spec.hpp"
 #include "names.hpp"
 #include "sensor_spec.hpp"
 
@@ -107,6 +108,7 @@ struct Case {
   std::vector<InputSpec> inputs;  ///< one per joint
   SimulationSettings sim;
   bool has_simulation = false;
+  AccuracySpec accuracy;           ///< [accuracy]: a target instead of an n (none: not given)
 };
 
 /// Reads and validates a case file; `overrides` are "key.path=value" strings applied before

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "../cases/case_file.hpp"
+#include "../simulation/common.hpp"
 
 namespace rfem::pyargs {
 
@@ -211,6 +212,16 @@ class CaseArg {
   std::optional<Case> loaded_;
   const Case* case_ = nullptr;
 };
+
+/// A steady joint rate (rfem.static, rfem.modes, rfem.refine: rate=, joint=).
+inline JointRate joint_rate(py::handle rate, py::handle joint) {
+  const std::optional<double> x = optional_real(rate, "rate", "a finite rate [rad/s or m/s] or None");
+  JointRate r;
+  r.given = x.has_value();
+  r.rate = x.value_or(0.0);
+  r.joint = positive(joint, "joint");
+  return r;
+}
 
 }  // namespace rfem::pyargs
 

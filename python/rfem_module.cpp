@@ -21,6 +21,7 @@
 #include "../results/xdmf.hpp"
 #include "../simulation/inputs.hpp"
 #include "../simulation/recorders.hpp"
+#include "../studies/accuracy.hpp"
 #include "../studies/modes_study.hpp"
 #include "../studies/refine.hpp"
 #include "../studies/resume.hpp"
@@ -92,14 +93,6 @@ std::vector<RunName> run_names(const std::vector<std::string>& names) {
   return out;
 }
 
-JointRate joint_rate(py::handle rate, py::handle joint) {
-  const std::optional<double> x = args::optional_real(rate, "rate", "a finite rate [rad/s or m/s] or None");
-  JointRate r;
-  r.given = x.has_value();
-  r.rate = x.value_or(0.0);
-  r.joint = args::positive(joint, "joint");
-  return r;
-}
 
 // `free` of rfem.modes: joint names or numbers from 1 (as --free), one or a list.
 std::vector<std::string> free_joints(py::handle v) {
@@ -140,6 +133,7 @@ RunRequest python_request(const std::shared_ptr<CallGuard>& pending, py::handle 
 
 void bind_sweep(py::module_& m);  // (sweep_bindings.cpp)
 void bind_simulation(py::module_& m);  // (simulation_bindings.cpp)
+void bind_accuracy(py::module_& m);  // (accuracy_bindings.cpp)
 
 PYBIND11_MODULE(_rfem, m) {
   m.doc() = "rfem's compiled core; use the package `rfem` (help(rfem)).";
@@ -388,7 +382,7 @@ PYBIND11_MODULE(_rfem, m) {
     return py::make_tuple(format_summary(s), entries, s.urdf, frames);
   }, py::arg("case"), py::arg("n"));
 
-  py::class_<StaticStudy, std::shared_ptr<StaticStudy>>(m, "StaticResult", "A static equilibrium (rfem.static).")
+  py::class_<StaticStudy, std::shared_ptr<StaticStudy>>(m, "StaticResult", "A static equilibrium (rfem.static).", py::dynamic_attr())
       .def_property_readonly("n", [](const StaticStudy& s) { return s.model->n(); })
       .def_property_readonly("iterations", [](const StaticStudy& s) { return s.solution.iterations; })
       .def_property_readonly("load_steps", [](const StaticStudy& s) { return s.solution.load_steps; })
@@ -412,7 +406,7 @@ PYBIND11_MODULE(_rfem, m) {
   m.def("_static", [](args::Typed<"Union[Case, str, os.PathLike]"> case_arg, args::Typed<"Optional[int]"> n_arg, args::Typed<"Optional[float]"> rate, args::Typed<"int"> joint) {
     const args::CaseArg cs(case_arg);
     const int n = args::rfes(n_arg);
-    const JointRate r = joint_rate(rate, joint);
+    const JointRate r = args::joint_rate(rate, joint);
     std::shared_ptr<StaticStudy> s;
     {
       py::gil_scoped_release release;
@@ -422,7 +416,7 @@ PYBIND11_MODULE(_rfem, m) {
     return s;
   }, py::arg("case"), py::arg("n"), py::arg("rate"), py::arg("joint"));
 
-  py::class_<ModesStudy, std::shared_ptr<ModesStudy>>(m, "ModesResult", "Natural frequencies and mode shapes (rfem.modes).")
+  py::class_<ModesStudy, std::shared_ptr<ModesStudy>>(m, "ModesResult", "Natural frequencies and mode shapes (rfem.modes).", py::dynamic_attr())
       .def_property_readonly("n", [](const ModesStudy& s) { return s.model->n(); })
       .def_property_readonly("solver", [](const ModesStudy& s) { return s.modes.dense ? "dense" : "lanczos"; })
       .def_property_readonly("omega", [](const ModesStudy& s) { return vector_array(s.modes.omega); }, "[rad/s]")
@@ -465,7 +459,7 @@ PYBIND11_MODULE(_rfem, m) {
     rq.n = args::rfes(n);
     rq.count = args::positive(count, "count");
     rq.free = free_joints(free);
-    rq.rate = joint_rate(rate, joint);
+    rq.rate = args::joint_rate(rate, joint);
     const std::string output = args::path(output_arg, "output", true);
     const std::string made_by = output.empty() ? "" : python_made_by("rfem.modes");
     py::gil_scoped_release release;
@@ -476,7 +470,7 @@ PYBIND11_MODULE(_rfem, m) {
 
   m.def("_refine", [](args::Typed<"Union[Case, str, os.PathLike]"> case_arg, args::Typed<"List[int]"> ns, args::Typed<"List[str]"> quantity_args, args::Typed<"Optional[Union[str, os.PathLike]]"> output_arg,
                       args::Typed<"bool"> integration_check, args::Typed<"Optional[float]"> rate, args::Typed<"int"> joint, args::Typed<"int"> threads, args::Typed<"Optional[Callable[[dict], Any]]"> progress,
-                      args::Typed<"Optional[List[int]]"> modes, args::Typed<"Optional[float]"> accuracy, args::Typed<"Optional[int]"> max_n) {
+                      args::Typed<"Optional[List[int]]"> modes, args::Typed<"Optional[List[str]]"> accuracy, args::Typed<"Optional[int]"> max_n) {
     const args::CaseArg cs_arg(case_arg);
     const Case& cs = *cs_arg;
     const std::vector<std::string> quantities = args::texts(quantity_args, "quantities");
@@ -485,12 +479,14 @@ PYBIND11_MODULE(_rfem, m) {
     pending->progress = args::callback(progress, "progress");
     RefineRequest rq;
     if (!ns.is_none()) rq.ns = args::rfes_list(ns, "ns");
-    if (!accuracy.is_none()) rq.accuracy = args::real(accuracy, "accuracy", "a relative error between 0 and 1");
-    if (!max_n.is_none()) rq.max_n = args::rfes(max_n, "max_n");
     if (!modes.is_none()) rq.modes = args::rfes_list(modes, "modes");
     rq.quantities = quantities;
+    // A target (as rfem refine): accuracy=, or the case's [accuracy] for a study without a ladder of its own.
+    const std::vector<std::string> given = accuracy.is_none() ? std::vector<std::string>{} : args::texts(accuracy, "accuracy");
+    const AccuracySpec target = target_of(cs, given, 0, max_n.is_none() ? 0 : args::rfes(max_n, "max_n"), true);
+    if (target.given() && (!given.empty() || (rq.modes.empty() && rq.ns.size() < 2))) apply_target(cs, target, rq);
     rq.integration_check = args::flag(integration_check, "integration_check");
-    rq.rate = joint_rate(rate, joint);
+    rq.rate = args::joint_rate(rate, joint);
     rq.threads = args::threads(threads);
     rq.stop = pending->stop;
     rq.progress = [pending](const Progress& p) { pending->beat(&p); };
@@ -507,10 +503,13 @@ PYBIND11_MODULE(_rfem, m) {
     out["status"] = res.status.to_string();
     out["ns"] = res.ns;
     out["modes"] = res.modes;
-    if (rq.accuracy) {
-      out["accuracy"] = *rq.accuracy;
+    if (!res.allowed.empty()) {  // (a target)
+      out["accuracy"] = rq.accuracy ? py::cast(*rq.accuracy) : py::none();
       out["met"] = res.met;
       out["shortfall"] = res.shortfall;
+      out["rtol"] = res.rtol;
+      out["atol"] = res.atol;
+      out["calibration"] = res.calibration;
     }
     py::list tables;
     for (size_t k = 0; k < res.tables.size(); ++k) {
@@ -532,6 +531,7 @@ PYBIND11_MODULE(_rfem, m) {
       d["asymptotic"] = t.asymptotic;
       d["reference"] = t.reference();
       d["warnings"] = t.warnings;
+      if (k < res.allowed.size()) d["allowed"] = res.allowed[k];
       tables.append(d);
     }
     out["tables"] = tables;
@@ -543,4 +543,5 @@ PYBIND11_MODULE(_rfem, m) {
      py::arg("max_n"));
   bind_sweep(m);
   bind_simulation(m);
+  bind_accuracy(m);
 }

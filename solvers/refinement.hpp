@@ -2,8 +2,9 @@
 // What a series of values over n (a refinement study) says: successive changes, the observed
 // order from three successive values, p = ln(|Δ_{i−1}| / |Δ_i|) / ln(n_i / n_{i−1}), Richardson
 // extrapolation of the last value, and whether the series can be trusted to say so. An order and
-// a Richardson value are given only where the changes shrink monotonically, the observed orders
-// agree, and the last change stands clear of the integration error (when that is known).
+// a Richardson value are given only where the last two changes (the three levels the GCI uses) have
+// one sign and shrink, the order is plausible, and the last change stands clear of the integration
+// error (when that is known); earlier levels may lie before the asymptotic range.
 #include <limits>
 #include <string>
 #include <vector>
@@ -34,8 +35,8 @@ struct Refinement {
   /// equations solved exactly (docs/accuracy.md says what it leaves out: the model's own form).
   /// The space part is Roache's grid convergence index over the last two n,
   /// Fs·|Δ|/(r^p − 1) with r = n_m/n_{m−1}, p = min(observed, theoretical): Fs = 1.25 where the
-  /// observed order is within 0.25 of the theoretical 2, else 3 (orders below 1 or above 4 give no
-  /// bar). The time part is the integration check's (0 for static and modal values; NaN where it
+  /// observed order is within 0.25 of the theoretical 2 and the last two orders agree (within 0.5),
+  /// else 3 (orders below 1 or above 4 give no bar). The time part is the integration check's (0 for static and modal values; NaN where it
   /// was not measured: then it is not in `error`). All NaN, and `asymptotic` false, where the series
   /// cannot be trusted (the warnings say why): no bar rather than a false one.
   double error = kNoBar, error_space = kNoBar, error_time = kNoBar;

@@ -60,26 +60,81 @@ bool evaluate_point(const Case& c, int n, const std::vector<JointInput>& inputs,
   return true;
 }
 
-// Whether every quantity's error bar over the series so far meets the relative target (the time
-// part, measured at the end, is not known yet).
-bool meets(const std::vector<int>& ns, const std::vector<std::vector<double>>& values, const std::vector<double>& time,
-           double target) {
-  for (size_t k = 0; k < values.size(); ++k) {
-    const Refinement r = assess_refinement(ns, values[k], time[k]);
-    if (!r.asymptotic || !(r.error <= target * std::abs(values[k].back()))) return false;
-  }
+// The largest |last value| of quantity k's group (its own without groups).
+double group_scale(const RefineRequest& rq, const std::vector<std::vector<double>>& values, size_t k) {
+  double scale = values[k].empty() ? 0.0 : std::abs(values[k].back());
+  if (!rq.groups.empty())
+    for (size_t j = 0; j < values.size(); ++j)
+      if (rq.groups[j] == rq.groups[k] && !values[j].empty()) scale = std::max(scale, std::abs(values[j].back()));
+  return scale;
+}
+
+// Whether quantity k is zero at every n so far, to round-off of its group's scale (a deflection
+// the case's symmetry keeps at zero): it needs no bar.
+bool identically_zero(const RefineRequest& rq, const std::vector<std::vector<double>>& values, size_t k) {
+  const double scale = group_scale(rq, values, k);
+  for (double v : values[k])
+    if (std::abs(v) > 1e-12 * scale) return false;
   return true;
 }
 
-// Per quantity that misses the target: why, and by how much (the n that would meet it, from the
+// The bar each quantity must meet, from the values so far: the relative target times the scale
+// (the largest |last value| of the quantity's group), or its absolute target, whichever is
+// smaller; infinite (no target) for a quantity without one or identically zero.
+std::vector<double> allowed_bars(const RefineRequest& rq, const std::vector<std::vector<double>>& values) {
+  const size_t m = values.size();
+  std::vector<double> out(m, INFINITY);
+  for (size_t k = 0; k < m; ++k) {
+    if (values[k].empty() || identically_zero(rq, values, k)) continue;
+    if (rq.accuracy) out[k] = *rq.accuracy * group_scale(rq, values, k);
+    if (!rq.absolute.empty() && std::isfinite(rq.absolute[k])) out[k] = std::min(out[k], rq.absolute[k]);
+  }
+  return out;
+}
+
+// Where a ladder with a target stands: every quantity with a target meets it (Met); every one
+// either meets it or has had no bar at the last two levels while its last two changes were already
+// below its target — an erratic series (a peak read on the output grid) that more levels do not
+// make asymptotic (Stalled: the ladder stops, not met); else it goes on.
+enum class LadderState { Met, Stalled, Going };
+
+bool erratic_below(const std::vector<int>& ns, const std::vector<double>& v, double allowed) {
+  const size_t m = v.size();
+  if (m < 4) return false;
+  const std::vector<int> before(ns.begin(), ns.end() - 1);
+  const std::vector<double> vb(v.begin(), v.end() - 1);
+  return !assess_refinement(before, vb, NAN).asymptotic && std::abs(v[m - 1] - v[m - 2]) <= allowed &&
+         std::abs(v[m - 2] - v[m - 3]) <= allowed;
+}
+
+LadderState ladder_state(const std::vector<int>& ns, const std::vector<std::vector<double>>& values,
+                         const std::vector<double>& time, const RefineRequest& rq) {
+  const std::vector<double> allowed = allowed_bars(rq, values);
+  bool met = true, stalled = true;
+  for (size_t k = 0; k < values.size(); ++k) {
+    if (!std::isfinite(allowed[k])) continue;
+    const Refinement r = assess_refinement(ns, values[k], time[k]);
+    if (r.asymptotic && r.error <= allowed[k]) continue;
+    met = false;
+    if (r.asymptotic || !erratic_below(ns, values[k], allowed[k])) stalled = false;
+  }
+  return met ? LadderState::Met : stalled ? LadderState::Stalled : LadderState::Going;
+}
+
+// Per quantity that misses its target: why, and by how much (the n that would meet it, from the
 // observed order, when the bar is there but too wide).
 std::vector<std::string> shortfall(const RefineResult& res, const RefineRequest& rq) {
   std::vector<std::string> out;
   for (size_t k = 0; k < res.tables.size(); ++k) {
     const Refinement& t = res.tables[k];
-    const double value = t.rows.back().value, want = *rq.accuracy * std::abs(value);
+    const double want = res.allowed[k];
+    if (!std::isfinite(want)) continue;
     const std::string q = res.quantities[k].text + " at n = " + std::to_string(res.ns.back()) + ": ";
-    if (!t.asymptotic) {
+    if (!t.asymptotic && erratic_below(res.ns, t.column(&RefinementRow::value), want)) {
+      out.push_back(q + fmt::format("no error bar: its last changes ({:.3g}, {:.3g}) are below the target {:.3g} but show no "
+                                    "order (an erratic series, e.g. a peak read on the output grid); not certified",
+                                    t.rows.back().change, t.rows[t.rows.size() - 2].change, want));
+    } else if (!t.asymptotic) {
       out.push_back(q + "no error bar (the series is not in the asymptotic range; see the warnings)");
     } else if (std::isfinite(t.error_time) && t.error_time > want) {
       out.push_back(q + fmt::format("the time error {:.3g} alone is above the target {:.3g}: tighten simulation.rtol and atol",
@@ -93,6 +148,42 @@ std::vector<std::string> shortfall(const RefineResult& res, const RefineRequest&
     }
   }
   return out;
+}
+
+// With a relative target: tightens the study's tolerances (from tolerances_for_target, tenfold each
+// time, at most kTightenings times) until the time error at the first n — against a rerun at
+// tolerances 100 times tighter — is at most kTimeShare of each quantity's allowed bar: a ladder that
+// meets its target ends on a change above about 0.6 of the bar (the level before did not meet
+// it), which then stands ten times clear of the time error, as assess_refinement asks. The time error depends on the motion far more than on n,
+// which is why the cheapest n measures it. Returns false if the study was stopped.
+constexpr int kTightenings = 4;
+constexpr double kTimeShare = 0.05;
+bool calibrate_tolerances(Case& study, int n0, const std::vector<JointInput>& inputs, const RefineRequest& rq,
+                          RefineResult& res) {
+  const std::vector<Quantity>& qs = res.quantities;
+  for (int attempt = 0;; ++attempt) {
+    if (rq.on_n) rq.on_n(-1, 0, n0);
+    Case tight = study;
+    tight.sim.options = tightened(study.sim.options, 100);
+    const auto v = evaluate_dynamic(study, inputs, n0, qs, fmt::format("tolerances{}/", attempt), rq);
+    if (rq.stop.requested()) break;
+    const auto vt = evaluate_dynamic(tight, inputs, n0, qs, fmt::format("tolerances{}_tight/", attempt), rq);
+    if (rq.stop.requested()) break;
+    std::vector<std::vector<double>> at_n0(qs.size());
+    for (size_t k = 0; k < qs.size(); ++k)
+      if (qs[k].dynamic()) at_n0[k].push_back(v[k]);
+    const std::vector<double> allowed = allowed_bars(rq, at_n0);
+    double worst = 0.0;  // the largest time error as a share of its allowed bar
+    for (size_t k = 0; k < qs.size(); ++k)
+      if (qs[k].dynamic() && std::isfinite(allowed[k])) worst = std::max(worst, std::abs(v[k] - vt[k]) / allowed[k]);
+    res.calibration.push_back(fmt::format("n = {}, rtol {:g}, atol {:g}: time error {:.2g} of the allowed bar{}", n0,
+                                          study.sim.options.rtol, study.sim.options.atol, worst,
+                                          worst <= kTimeShare ? fmt::format(" (at most {:g}: kept)", kTimeShare) : ""));
+    if (worst <= kTimeShare || attempt + 1 == kTightenings) return true;
+    study.sim.options = tightened(study.sim.options, 10);
+  }
+  res.status = RunStatus::interrupted(rq.stop.signal());
+  return false;
 }
 
 // The case with every flexible link at n reduced to m modes (0: every rfe coordinate).
@@ -139,10 +230,26 @@ RefineResult refine_modes(const Case& cs, const RefineRequest& rq, RefineResult 
 
 }  // namespace
 
+IntegratorOptions tightened(IntegratorOptions o, double factor) {
+  o.rtol /= factor;
+  o.atol /= factor;
+  o.atol_velocity /= factor;
+  o.atol_energy /= factor;
+  o.max_steps = static_cast<long>(std::min(1e9, o.max_steps * factor));
+  return o;
+}
+
+IntegratorOptions tolerances_for_target(IntegratorOptions o, double relative) {
+  o.rtol = std::min(1e-5, relative / 1000);
+  o.atol = o.rtol / 100;
+  o.atol_velocity = std::min(o.atol_velocity, o.rtol * 1000);
+  return o;
+}
+
 std::vector<Quantity> check_refinement(const Case& cs, const RefineRequest& rq) {
   if (rq.quantities.empty()) throw CaseError("--quantity: give at least one quantity (see rfem refine --help)");
   if (!rq.modes.empty()) {
-    if (rq.accuracy) throw CaseError("--accuracy: a target is met over n, not over --modes");
+    if (rq.accuracy || !rq.absolute.empty()) throw CaseError("--accuracy: a target is met over n, not over --modes");
     if (rq.ns.size() != 1) throw CaseError("--n: a series over --modes takes one n (got " + std::to_string(rq.ns.size()) + ")");
     if (rq.ns[0] < 1) throw CaseError("--n: must be a positive integer (got " + std::to_string(rq.ns[0]) + ")");
     for (size_t i = 0; i < rq.modes.size(); ++i) {
@@ -156,9 +263,16 @@ std::vector<Quantity> check_refinement(const Case& cs, const RefineRequest& rq) 
     for (int m : rq.modes) build_model(with_modes(cs, rq.ns[0], m), rq.ns[0]);  // more modes than a link has fails here
     return qs;
   }
-  if (rq.accuracy) {
-    if (!(*rq.accuracy > 0.0 && *rq.accuracy < 1.0))
-      throw CaseError(fmt::format("--accuracy: a relative error between 0 and 1, e.g. 1e-3 (got {})", *rq.accuracy));
+  if (!rq.absolute.empty() && rq.absolute.size() != rq.quantities.size())
+    throw CaseError(fmt::format("absolute targets: one per quantity (got {} for {})", rq.absolute.size(), rq.quantities.size()));
+  if (!rq.groups.empty() && rq.groups.size() != rq.quantities.size())
+    throw CaseError(fmt::format("groups: one per quantity (got {} for {})", rq.groups.size(), rq.quantities.size()));
+  for (size_t k = 0; k < rq.absolute.size(); ++k)
+    if (!(rq.absolute[k] > 0.0) && !std::isnan(rq.absolute[k]))
+      throw CaseError(fmt::format("--accuracy {}: an absolute error bar must be positive (got {})", rq.quantities[k], rq.absolute[k]));
+  const bool targeted = rq.accuracy || std::any_of(rq.absolute.begin(), rq.absolute.end(), [](double a) { return std::isfinite(a); });
+  if (rq.accuracy) check_relative_target(*rq.accuracy, "--accuracy");
+  if (targeted) {
     if (rq.max_n < 2) throw CaseError("--max-n: must be at least 2 (got " + std::to_string(rq.max_n) + ")");
     if (!rq.ns.empty() && rq.ns.back() > rq.max_n)
       throw CaseError("--n: " + std::to_string(rq.ns.back()) + " is above --max-n " + std::to_string(rq.max_n));
@@ -173,7 +287,7 @@ std::vector<Quantity> check_refinement(const Case& cs, const RefineRequest& rq) 
   std::vector<Quantity> qs;
   for (const auto& text : rq.quantities) qs.push_back(parse_quantity(cs, text));
   for (int n : rq.ns) build_model(cs, n);  // an impossible discretisation fails here
-  if (rq.accuracy && rq.ns.empty()) build_model(cs, kFirstTargetN);
+  if (targeted && rq.ns.empty()) build_model(cs, kFirstTargetN);
   return qs;
 }
 
@@ -184,18 +298,24 @@ RefineResult refine(const Case& cs, const RefineRequest& rq) {
   res.dynamic = std::any_of(qs.begin(), qs.end(), [](const Quantity& q) { return q.dynamic(); });
   const std::vector<JointInput> inputs = res.dynamic ? joint_inputs(cs, rq.warn) : std::vector<JointInput>{};
   if (!rq.modes.empty()) return refine_modes(cs, rq, std::move(res), inputs);
-  const Case& study = cs;
+  const bool targeted = rq.accuracy || std::any_of(rq.absolute.begin(), rq.absolute.end(), [](double a) { return std::isfinite(a); });
+  Case study = cs;
+  std::vector<int> ladder = rq.ns;
+  if (targeted && ladder.empty()) ladder.push_back(kFirstTargetN);
+  res.status = RunStatus::completed();
+  if (res.dynamic && rq.accuracy) {
+    study.sim.options = tolerances_for_target(cs.sim.options, *rq.accuracy);
+    if (!calibrate_tolerances(study, ladder[0], inputs, rq, res)) return res;
+  }
+  res.rtol = study.sim.options.rtol;
+  res.atol = study.sim.options.atol;
   std::vector<std::vector<double>> values(qs.size());
   std::vector<double> integration(qs.size(), 0.0);  // (none in a static or modal value)
   for (size_t k = 0; k < qs.size(); ++k)
     if (qs[k].dynamic()) integration[k] = NAN;  // (not measured, unless checked below)
-  const bool targeted = rq.accuracy.has_value();
-  std::vector<int> ladder = rq.ns;
-  if (targeted && ladder.empty()) ladder.push_back(kFirstTargetN);
-  res.status = RunStatus::completed();
   for (size_t i = 0;; ++i) {
     if (i == ladder.size()) {  // a target: three levels at least, then until the bars meet it
-      if (!targeted || (ladder.size() >= 3 && meets(res.ns, values, integration, *rq.accuracy))) break;
+      if (!targeted || (ladder.size() >= 3 && ladder_state(res.ns, values, integration, rq) != LadderState::Going)) break;
       if (2 * ladder.back() > rq.max_n) break;
       ladder.push_back(2 * ladder.back());
     }
@@ -208,9 +328,7 @@ RefineResult refine(const Case& cs, const RefineRequest& rq) {
   if (res.dynamic && rq.integration_check && res.status.is_completed()) {
     if (rq.on_n) rq.on_n(static_cast<int>(res.ns.size()), static_cast<int>(res.ns.size()), res.ns.back());
     Case tight = study;
-    tight.sim.options.rtol /= 100;
-    tight.sim.options.atol /= 100;
-    tight.sim.options.max_steps *= 100;
+    tight.sim.options = tightened(study.sim.options, 100);
     const auto ref = evaluate_dynamic(tight, inputs, res.ns.back(), qs, fmt::format("check_n{}/", res.ns.back()), rq);
     if (rq.stop.requested()) res.status = RunStatus::interrupted(rq.stop.signal());
     else
@@ -218,6 +336,8 @@ RefineResult refine(const Case& cs, const RefineRequest& rq) {
         if (qs[k].dynamic()) integration[k] = std::abs(values[k].back() - ref[k]);
   }
   for (size_t k = 0; k < qs.size(); ++k) res.tables.push_back(assess_refinement(res.ns, values[k], integration[k]));
+  if (targeted) res.allowed = allowed_bars(rq, values);
+  for (size_t k = 0; k < qs.size(); ++k) res.zero.push_back(!values[k].empty() && identically_zero(rq, values, k));
   if (targeted && res.status.is_completed()) res.shortfall = shortfall(res, rq);
   res.met = targeted && res.status.is_completed() && res.shortfall.empty();
   return res;

@@ -27,16 +27,23 @@ struct RefineRequest {
   std::vector<int> modes;
   std::vector<std::string> quantities;  ///< at least one (studies/quantities.hpp)
   bool integration_check = true;        ///< rerun the finest n at 100× tighter tolerances
-  /// A target instead of a ladder (> 0): the relative error bar every quantity's value must meet
-  /// (Refinement::error ≤ accuracy·|value|). The series doubles n from the last of `ns` (from
-  /// kFirstTargetN without one) until every bar meets it, or the next n would pass max_n.
+  /// A target instead of a ladder (kMinRelativeTarget ≤ accuracy < 1): the relative error bar every
+  /// quantity's value must meet; dynamic quantities are then integrated at tolerances chosen for it
+  /// (tolerances_for_target, measured and tightened at the first n), not the case's (Refinement::error ≤ accuracy·scale, the scale |value| or the largest
+  /// |value| of its group). The series doubles n from the last of `ns` (from kFirstTargetN without
+  /// one) until every bar meets its target, or the next n would pass max_n.
   std::optional<double> accuracy;
+  /// Absolute targets, one per quantity (NaN: none; empty: none at all): the bar at most this.
+  std::vector<double> absolute;
+  /// Quantities that share a scale for the relative target (one id per quantity; empty: each its own).
+  std::vector<int> groups;
   int max_n = kMaxTargetN;
   JointRate rate;                       ///< for static and modal quantities
   int threads = 0;
   StopToken stop;                       ///< ends the study after the current run; rows done are kept
-  /// Before each n (index from 0, count, n; index = count for the integration check); with
-  /// `modes`, before each m (n the m; 0: the full model, first).
+  /// Before each n (index from 0, count, n; index = count for the integration check; count 0 in a
+  /// ladder towards a target, index −1 while the tolerances are chosen there); with `modes`, before
+  /// each m (n the m; 0: the full model, first).
   std::function<void(int index, int count, int n)> on_n;
   std::function<void(const Progress&)> progress;  ///< inside each run
   std::vector<RunObserver*> observers;  ///< see every run ("n12/kinematic", "check_n24/run")
@@ -56,7 +63,21 @@ struct RefineResult {
   /// that did not, why and by how much (one line each: not success).
   bool met = false;
   std::vector<std::string> shortfall;
+  std::vector<double> allowed;         ///< with a target: each quantity's bar must be ≤ this (inf: no target)
+  /// Per quantity: zero at every n, to 1e-12 of its group's scale (by the case's symmetry): no bar needed.
+  std::vector<bool> zero;
+  double rtol = 0.0, atol = 0.0;       ///< the tolerances the runs used (dynamic quantities; chosen or the case's)
+  /// With a relative target and dynamic quantities: how the tolerances were chosen, a line per try.
+  std::vector<std::string> calibration;
 };
+
+/// The integration tolerances a relative target asks for (docs/accuracy.md, measured there): rtol =
+/// min(1e-5, target/1000), atol = rtol/100 [m, rad] and atol_velocity no looser than rtol·1000 (the
+/// defaults' ratios), the rest as in `o`.
+IntegratorOptions tolerances_for_target(IntegratorOptions o, double relative);
+/// Every tolerance `factor` times tighter (rtol, atol, atol_velocity, atol_energy) and as many more
+/// steps allowed: the integration check's rerun (factor 100), a target's tightening (10).
+IntegratorOptions tightened(IntegratorOptions o, double factor);
 
 /// Checks every quantity and every n before the first run (CaseError), then runs the study.
 /// A run that does not complete throws std::runtime_error ("n = 24: force failed: …").

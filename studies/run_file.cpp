@@ -50,8 +50,9 @@ RefineResult refine_into_file(const Case& cs, RefineRequest rq, const std::strin
   const RefineResult res = refine(cs, rq);
   if (res.modes.empty()) file.write_refinement(rq.quantities, res.ns, res.tables, res.status);
   else file.write_refinement(rq.quantities, res.modes, res.tables, res.status, rq.ns[0]);
-  if (rq.accuracy) {  // the target, whether it was met, and what missed it
-    file.write_attribute("refine", "accuracy", *rq.accuracy);
+  if (!res.allowed.empty()) {  // the target, whether it was met, and what missed it
+    if (rq.accuracy) file.write_attribute("refine", "accuracy", *rq.accuracy);
+    if (res.dynamic) file.write_attribute("refine", "rtol", res.rtol), file.write_attribute("refine", "atol", res.atol);
     file.write_attribute("refine", "met", res.met ? 1.0 : 0.0);
     if (!res.shortfall.empty()) file.write_attribute("refine", "shortfall", res.shortfall);
   }

@@ -27,7 +27,7 @@ import json as _json
 import os as _os
 
 from . import _rfem
-from ._rfem import (MAX_RFES, Case, CaseError, LinearModel, Model, ModesResult, ResultsError, Run, RunStatus, StaticResult, Sweep,
+from ._rfem import (MAX_RFES, Accuracy, Case, CaseError, LinearModel, Model, ModesResult, ResultsError, Run, RunStatus, StaticResult, Sweep,
                     __version__, build)
 
 
@@ -56,7 +56,7 @@ _os.register_at_fork(after_in_child=_rfem._after_fork)
 for _f in (run_point, finished_point, write_index, write_xdmf):
     _f.__doc__ = getattr(_rfem, _f.__name__).__doc__.split("\n", 1)[-1].strip()
 
-__all__ = ["Case", "CaseError", "Frame", "LinearModel", "linearize", "Model", "ModesResult", "ResultsError", "Run", "RunInterrupted", "RunStatus", "Runs",
+__all__ = ["Accuracy", "Case", "CaseError", "Frame", "LinearModel", "linearize", "Model", "ModesResult", "ResultsError", "Run", "RunInterrupted", "RunStatus", "Runs",
            "StaticResult", "RefineResult", "Tree", "load", "model", "show", "run", "static", "modes", "refine", "plot",
            "write_xdmf", "animate", "toml_value", "__version__", "Sweep", "SweepResult", "load_sweep", "sweep", "run_point",
            "finished_point", "write_index"]
@@ -132,6 +132,32 @@ def _frame(self, name):
 Run.frame = _frame
 
 
+def _accuracy_texts(accuracy):
+    """accuracy= as the program's --accuracy texts: 1e-3 (relative), "peak:u1=2e-4",
+    {"peak:u1": 2e-4}, or a list of these."""
+    if accuracy is None:
+        return None
+    if isinstance(accuracy, bool):
+        raise TypeError("accuracy: a relative error (1e-3), 'QUANTITY=ERROR', {QUANTITY: ERROR} or a list of these, not bool")
+    if isinstance(accuracy, (int, float)):
+        return [repr(float(accuracy))]
+    if isinstance(accuracy, str):
+        return [accuracy]
+    if isinstance(accuracy, dict):
+        return [f"{q}={_accuracy_texts(e)[0]}" for q, e in accuracy.items()]
+    if isinstance(accuracy, (list, tuple)):
+        return [t for a in accuracy for t in _accuracy_texts(a)]
+    raise TypeError("accuracy: a relative error (1e-3), 'QUANTITY=ERROR', {QUANTITY: ERROR} or a list of these, "
+                    f"not {type(accuracy).__name__}")
+
+
+def _target(case, command, accuracy, max_n, n, count=6, rate=None, joint=1, threads=0, progress=None):
+    """The Accuracy a target asks for (accuracy=, or the case's [accuracy] without n), or None."""
+    acc, error = _rfem._accuracy(case, command, _accuracy_texts(accuracy), max_n, n, count, rate, joint, threads, progress)
+    _raise(error, acc)
+    return acc
+
+
 def load(path, values=None, overrides=()):
     """Reads and checks a case file (TOML). `values`: {path: value} as in Case.with_values;
     `overrides`: 'key.path=value' strings as given to `rfem --set`."""
@@ -161,13 +187,14 @@ class Runs(list):
 
     warnings = ()
     kept = ()
+    accuracy = None  # rfem.Accuracy with accuracy= (each peak with its error bar)
 
     def __repr__(self):
         return "<rfem.Runs " + ", ".join(f"{r.name}: {r.status}" for r in self) + ">"
 
 
 def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, progress=None, resume=None,
-        checkpoint=_rfem.CHECKPOINT_INTERVAL, controller=None, sample_time=None, delay=0):
+        checkpoint=_rfem.CHECKPOINT_INTERVAL, controller=None, sample_time=None, delay=0, accuracy=None, max_n=None):
     """Runs the case's [simulation] by its procedure (single: "run"; paper: "rigid", "kinematic",
     "force") and returns the Runs.
 
@@ -188,6 +215,10 @@ def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, 
                  output or runs: the file has them); returns the runs run now (.kept: the names of
                  those that had completed), their series read back whole from the file
     checkpoint:  seconds of wall time between checkpoints written into `output` (0: none)
+    accuracy:    a target instead of n (`rfem run --accuracy`; the case's [accuracy] applies without
+                 n): 1e-3 (relative to each peak's scale), "peak:force/u1=2e-4" or {"peak:u1": 2e-4}
+                 (absolute), or a list; rfem chooses the tolerances and n (up to max_n, default 2048)
+                 and the Runs carry .accuracy (rfem.Accuracy: each peak with its error bar; .met)
 
     A run that fails has status "failed: …" (the outputs before kept); Ctrl-C raises
     RunInterrupted with the runs so far in .result."""
@@ -210,10 +241,20 @@ def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, 
         result = Runs([run_controlled(case, controller, sample_time, n=n, delay=delay, output=output, threads=threads,
                                       keep_series=keep_series)])
         return result
+    acc = _target(case, "run", accuracy, max_n, n, threads=threads, progress=progress)
+    if acc is not None:
+        if runs is not None:
+            raise ValueError("rfem.run(accuracy=...) runs the whole procedure: no runs with it")
+        case = (case if isinstance(case, Case) else load(case)).with_values({"simulation.rtol": acc.rtol,
+                                                                              "simulation.atol": acc.atol})
+        n = acc.n
     out, error, warnings = _rfem._run(case, n, output, runs, threads, keep_series, progress, checkpoint)
     result = Runs(out)
     result.warnings = warnings
+    result.accuracy = acc
     _raise(error, result)
+    if acc is not None and output is not None and result.completed:
+        _rfem._write_accuracy(output, acc)
     return result
 
 
@@ -245,20 +286,32 @@ def show(case, n=None):
     return tree
 
 
-def static(case, n=None, rate=None, joint=1):
+def static(case, n=None, rate=None, joint=1, accuracy=None, max_n=None):
     """Static equilibrium with the joints held at their values (or turning steadily: `rate`
     [rad/s or m/s] of joint `joint`, from 1) under gravity and the case's tip loads. Returns a
-    StaticResult (tips per link, energies, coordinates)."""
-    return _rfem._static(case, n, rate, joint)
+    StaticResult (tips per link, energies, coordinates). accuracy= (as rfem.run's; `rfem static
+    --accuracy`): n chosen for the tips' displacements and rotations; .accuracy has their bars."""
+    acc = _target(case, "static", accuracy, max_n, n, rate=rate, joint=joint)
+    result = _rfem._static(case, acc.n if acc is not None else n, rate, joint)
+    result.accuracy = acc
+    return result
 
 
-def modes(case, n=None, count=6, free=(), rate=None, joint=1, output=None):
+def modes(case, n=None, count=6, free=(), rate=None, joint=1, output=None, accuracy=None, max_n=None):
     """Natural frequencies and mode shapes of the flexible links about the static equilibrium,
     joints held except those in `free` (numbers from 1, names, or "base"), optionally in a frame
     turning at `rate` about joint `joint`. Returns a ModesResult (frequencies [Hz], kinds,
     shapes, exact references for one uniform segment); `output`: an HDF5 file with the
-    frequencies and shapes (group modes, as `rfem modes -o`)."""
-    return _rfem._modes(case, n, count, free, rate, joint, output)
+    frequencies and shapes (group modes, as `rfem modes -o`). accuracy= (as rfem.run's; `rfem
+    modes --accuracy`): n chosen for the first `count` frequencies; .accuracy has their bars."""
+    acc = _target(case, "modes", accuracy, max_n, n, count=count, rate=rate, joint=joint)
+    if acc is not None and free:
+        raise CaseError("--accuracy: modes with --free joints are not refined yet; give --n")
+    result = _rfem._modes(case, acc.n if acc is not None else n, count, free, rate, joint, output)
+    result.accuracy = acc
+    if acc is not None and output is not None:
+        _rfem._write_accuracy(output, acc)
+    return result
 
 
 class RefineResult(dict):
@@ -266,7 +319,7 @@ class RefineResult(dict):
     "n", "value", "change", "order", "richardson" (arrays), "fitted_order",
     "integration_error", "reference", "warnings" and the error bar of the last value, value[-1]:
     "error" = "error_space" (Roache's grid convergence index) + "error_time" (the integration
-    check; 0 for static and modal values), "observed_order" and "asymptotic" (False, and the bar
+    check; 0 for static and modal values), "allowed" (with a target: the bar it asked for), "observed_order" and "asymptotic" (False, and the bar
     NaN, where the series does not show the asymptotic range: no bar rather than a false one);
     table("peak:u1") finds one by name."""
 
@@ -288,13 +341,14 @@ def refine(case, ns, quantities, output=None, integration_check=True, rate=None,
     Dynamic quantities share one run per n; `output` keeps every run and the tables in HDF5.
     modes=[4, 8, 16] (`rfem refine --modes`): a series over modes instead, at the one n of `ns`:
     every flexible link reduced to m modes, then the full model; each table's "modes" (0: full),
-    "value" and "change" (value − the full model's). accuracy=1e-3 (`rfem refine --accuracy`): a
-    relative error bar every quantity must meet instead of a fixed series: n doubles from the last
-    of `ns` (or 8, with ns=None) until every table's "error" ≤ accuracy·|value[-1]| or the next n
+    "value" and "change" (value − the full model's). accuracy=1e-3 (`rfem refine --accuracy`; also
+    "peak:u1=2e-4", {"peak:u1": 2e-4} or a list): an error bar every quantity must meet instead of a
+    fixed series: the tolerances chosen for it (["rtol"], ["atol"], ["calibration"]), n doubles from
+    the last of `ns` (or 8, with ns=None) until every table's "error" ≤ its "allowed" or the next n
     passes max_n (2048); ["met"] says whether it was, ["shortfall"] why not and by how much.
     Ctrl-C raises RunInterrupted with the rows done in .result."""
     out, error = _rfem._refine(case, ns, quantities, output, integration_check, rate, joint, threads, progress, modes,
-                               accuracy, max_n)
+                               _accuracy_texts(accuracy), max_n)
     result = RefineResult(out)
     _raise(error, result)
     return result

@@ -95,10 +95,36 @@ def test_static_modes_refine_equal_program():
     assert code == 0 and js["met"] and acc["met"]
     assert [r["n"] for r in js["quantities"][0]["rows"]] == list(acc["ns"]) and acc["ns"][0] == 8
     assert acc["tables"][0]["error"] <= 1e-4 * acc["tables"][0]["value"][-1]
-    code, out, err = program("refine", case_path("kane_beam.toml"), "--quantity", "mode:1", "--accuracy", "1e-9", "--max-n", "32")
+    code, out, err = program("refine", case_path("kane_beam.toml"), "--quantity", "mode:1", "--accuracy", "1e-8", "--max-n", "32")
     assert code == 3 and "NOT met" in out and "n ≈" in out
-    short = rfem.refine(rfem.load(case_path("kane_beam.toml")), None, ["mode:1"], accuracy=1e-9, max_n=32)
+    short = rfem.refine(rfem.load(case_path("kane_beam.toml")), None, ["mode:1"], accuracy=1e-8, max_n=32)
     assert not short["met"] and len(short["shortfall"]) == 1
+
+
+def test_accuracy_on_modes_static_and_run(tmp_path):
+    """accuracy= on rfem.modes, rfem.static and rfem.run: the program's n, values and bars
+    (`--accuracy`), the absolute form as a dict, the same one-line refusals (docs/accuracy.md)."""
+    beam = case_path("kane_beam.toml")
+    code, out, err = program("modes", beam, "--accuracy", "1e-4", "--count", "3", "--json")
+    js = json.loads(out)["accuracy"]
+    m = rfem.modes(beam, count=3, accuracy=1e-4)
+    assert code == 0 and m.accuracy.met and m.n == js["n"] == m.accuracy.n
+    for e, f in zip(js["estimates"], m.accuracy.estimates):
+        assert e["quantity"] == f["quantity"] and e["value"] == f["value"] and e["error"] == f["error"]
+    assert list(m.frequencies[:3]) == pytest.approx([e["value"] for e in js["estimates"]], rel=1e-12)  # (the modes there)
+    s = rfem.static(beam, accuracy={"tip:uz": 1e-6})
+    assert s.accuracy["tip:uz"]["error"] <= 1e-6 and s.accuracy["tip:uz"]["allowed"] == 1e-6
+    runs = rfem.run(case_path("kane_spinup.toml"), accuracy=1e-3, threads=1, output=tmp_path / "k.h5", keep_series=False)
+    u1 = runs.accuracy["peak:run/u1"]
+    assert runs.accuracy.met and abs(u1["value"] - 0.5738494557) <= u1["error"] and runs.accuracy.rtol <= 1e-6
+    for bad in (-1e-3, 0.0, float("nan"), 1e-12, "peak:nope=1e-3"):
+        with pytest.raises(rfem.CaseError) as e:
+            rfem.run(case_path("kane_spinup.toml"), accuracy=bad)
+        code, _, err = program("run", case_path("kane_spinup.toml"), "--accuracy", repr(bad) if isinstance(bad, float) else bad,
+                               "-o", str(tmp_path / "bad.h5"))
+        assert code == 2 and err.strip() == "rfem: error: " + str(e.value)
+    with pytest.raises(rfem.CaseError):
+        rfem.modes(beam, n=16, accuracy=1e-3)
 
 
 @pytest.mark.parametrize("bad", ["14_negative_E.toml", "85_unknown_parent.toml", "51_unknown_input_kind.toml",
