@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "../results/errors.hpp"
 #include "../simulation/recorders.hpp"
@@ -16,6 +17,17 @@ int run_linearize(const Common& c, const LinearizeOptions& o) {
   const Case cs = read_checked_case(c);
   LinearizeRequest rq;
   rq.n = c.n;
+  // A target: n from a refinement of the linear model's six lowest frequencies (studies/accuracy.hpp).
+  const AccuracySpec target = accuracy_target(cs, c);
+  std::optional<AccuracyResult> acc;
+  if (target.given()) {
+    if (!o.state.empty()) throw CaseError("--accuracy: a saved state has its own n (give no --state, or no target)");
+    RefineRequest base;
+    base.warn = print_warning;
+    base.on_n = ladder_lines(target, c.json || c.quiet);
+    acc = meet_accuracy(cs, target, reported_by_linearize(6), base);
+    rq.n = acc->n;
+  }
   rq.threads = c.threads > 0 ? c.threads : 1;
   rq.equilibrium = !o.on_motion;
   rq.dense = o.dense;
@@ -35,6 +47,8 @@ int run_linearize(const Common& c, const LinearizeOptions& o) {
   // The first-order model's eigenvalues: frequencies [Hz] and damping ratios of its lowest modes.
   const std::vector<std::pair<double, double>> modes = linear_modes(lin, 6);
   const int shown = static_cast<int>(modes.size());
+  if (acc) write_accuracy(o.output, *acc);
+  const int code = acc && !acc->met ? 3 : 0;  // (a target that was not met is not success)
   if (c.json) {
     nlohmann::json f = nlohmann::json::array(), z = nlohmann::json::array();
     for (int i = 0; i < shown; ++i) {
@@ -45,10 +59,13 @@ int run_linearize(const Common& c, const LinearizeOptions& o) {
                 {"about", lin.equilibrium ? "equilibrium" : "state"}, {"states", lin.states.size()},
                 {"inputs", lin.inputs}, {"outputs", lin.outputs.size()}, {"imbalance", lin.imbalance},
                 {"evaluations", lin.evaluations}, {"nonzeros", {{"M", lin.M.nonZeros()}, {"D", lin.D.nonZeros()}, {"K", lin.K.nonZeros()}}},
-                {"frequencies_hz", f}, {"damping_ratios", z}});
-    return 0;
+                {"frequencies_hz", f}, {"damping_ratios", z}, {"accuracy", acc ? accuracy_json(*acc) : nlohmann::json(nullptr)}});
+    return code;
   }
-  if (c.quiet) return 0;
+  if (c.quiet) {
+    if (acc) print_accuracy(*acc);
+    return code;
+  }
   std::string inputs;
   for (const auto& s : lin.inputs) inputs += (inputs.empty() ? "" : ", ") + s;
   fmt::print("linear model of {} about {} at t = {:g} s: {} states ({} first order), {} inputs ({}), {} outputs\n",
@@ -61,7 +78,8 @@ int run_linearize(const Common& c, const LinearizeOptions& o) {
   const bool first_order = static_cast<int>(lin.states.size()) <= LinearModel::kFileDenseStates;
   fmt::print("wrote {} (group linear: M, D, K, B sparse; Cq, Cv, Ca{}) from {} evaluations of the equations\n", o.output,
              first_order ? "; A, Bs, C, Ds" : "", lin.evaluations);
-  return 0;
+  if (acc) print_accuracy(*acc);
+  return code;
 }
 
 }  // namespace rfem::app

@@ -178,6 +178,7 @@ int main(int argc, char** argv) {
   add_rate(rf);
   auto* ln = app.add_subcommand("linearize", "the linear model M, D, K, B, C and A, B, C, D about the initial equilibrium or a saved state");
   add_common(ln, true);
+  add_accuracy(ln);
   LinearizeOptions lo;
   ln->add_option("-o,--output", lo.output, "HDF5 file for the matrices (group linear)")->required();
   ln->add_option("--state", lo.state, "about this saved simulation state (rfem.SimulationState.save; default: the initial equilibrium)");

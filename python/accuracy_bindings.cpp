@@ -82,7 +82,8 @@ void bind_accuracy(py::module_& m) {
     if (command == "run") reported = reported_by_run(cs);
     else if (command == "modes") reported = reported_by_modes(args::positive(count, "count"));
     else if (command == "static") reported = reported_by_static(cs, base.rate);
-    else throw py::value_error("command: run, modes or static");
+    else if (command == "linearize") reported = reported_by_linearize(6);
+    else throw py::value_error("command: run, modes, static or linearize");
     auto pending = std::make_shared<CallGuard>();
     pending->progress = args::callback(progress, "progress");
     base.threads = args::threads(threads);

@@ -174,7 +174,7 @@ void bind_simulation(py::module_& m) {
       m, "LinearModel",
       "A linear model about a state (rfem.linearize, Simulation.linearize): M q'' + D q' + K q = B u, "
       "y = Cq q + Cv q' + Ca q'' (deviations from the operating point; SI units, rows and columns named by "
-      "states, inputs, outputs); state_space() gives A, B, C, D of x = (q, q').");
+      "states, inputs, outputs); state_space() gives A, B, C, D of x = (q, q').", py::dynamic_attr());
   py::class_<PySimulation>(m, "_Simulation")
       .def(py::init([](args::Typed<"Union[Case, str, os.PathLike]"> case_arg, args::Typed<"Optional[int]"> n, args::Typed<"int"> threads, args::Typed<"Optional[Union[str, os.PathLike]]"> output, args::Typed<"bool"> keep_series,
                        std::optional<SimulationState> state, const std::string& made_by) {

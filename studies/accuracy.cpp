@@ -35,6 +35,12 @@ Reported reported_by_modes(int count) {
   return r;
 }
 
+Reported reported_by_linearize(int count) {
+  Reported r;
+  for (int k = 1; k <= count; ++k) r.add("linear:" + std::to_string(k), k);
+  return r;
+}
+
 Reported reported_by_static(const Case& cs, const JointRate& rate) {
   static const char* names[6] = {"ux", "uy", "uz", "rx", "ry", "rz"};
   const StaticStudy s = static_study(cs, kFirstTargetN, rate);

@@ -41,6 +41,8 @@ struct Reported {
 Reported reported_by_run(const Case& cs);
 /// `rfem modes`: the first `count` frequencies (each its own scale).
 Reported reported_by_modes(int count);
+/// `rfem linearize`: the linear model's first `count` frequencies about rest (`linear:K`).
+Reported reported_by_linearize(int count);
 /// `rfem static`: every link's tip displacements (one scale) and rotations (another), those that are
 /// not zero at n = kFirstTargetN (the rest are zero by symmetry and stay so).
 Reported reported_by_static(const Case& cs, const JointRate& rate = {});

@@ -11,6 +11,7 @@
 #include "../simulation/state.hpp"
 #include "../solvers/modes.hpp"
 #include "../solvers/statics.hpp"
+#include "linearize.hpp"
 
 namespace rfem {
 
@@ -51,9 +52,9 @@ void parse_static(const Case& cs, const std::string& text, Quantity& s) {
       }
     throw CaseError("--quantity " + quantity + ": tip component must be ux, uy, uz, rx, ry or rz");
   }
-  if (what != "mode" && what != "axial" && what != "bending-y" && what != "bending-z" && what != "torsion")
+  if (what != "mode" && what != "axial" && what != "bending-y" && what != "bending-z" && what != "torsion" && what != "linear")
     throw CaseError("--quantity " + quantity + ": unknown quantity '" + what +
-                    "' ([LINK/]tip:ux…rz, mode:K, axial:K, bending-y:K, bending-z:K, torsion:K; dynamic: "
+                    "' ([LINK/]tip:ux…rz, mode:K, axial:K, bending-y:K, bending-z:K, torsion:K, linear:K; dynamic: "
                     "peak|max|min|rms|mean:SERIES[t1:t2] or SERIES@T, SERIES = [RUN/][LINK/]u1|u2|theta|tauJ|qJ|vJ|aJ "
                     "or the difference of two)");
   size_t used = 0;
@@ -64,7 +65,7 @@ void parse_static(const Case& cs, const std::string& text, Quantity& s) {
   }
   if (used == 0 || used != arg.size() || s.mode < 1)
     throw CaseError("--quantity " + quantity + ": expected " + what + ":K with an integer K ≥ 1");
-  s.kind = what == "mode" ? Quantity::Kind::Mode : Quantity::Kind::ModeOfKind;
+  s.kind = what == "mode" ? Quantity::Kind::Mode : what == "linear" ? Quantity::Kind::LinearMode : Quantity::Kind::ModeOfKind;
   s.mode_kind = what;
 }
 
@@ -214,6 +215,15 @@ double evaluate_quantity(const Case& cs, int n, const Quantity& s, const JointRa
     return tip_motion(model, l, solve_static(model, qb, vb, cs.loads).q)[s.component];
   }
   const int k = s.mode;
+  if (s.kind == Quantity::Kind::LinearMode) {
+    LinearizeRequest rq;
+    rq.n = n;
+    const auto modes = linear_modes(linearize(cs, rq), k);
+    if (static_cast<int>(modes.size()) < k)
+      throw CaseError("--quantity " + s.text + ": the linear model at n = " + std::to_string(n) + " has " +
+                      std::to_string(modes.size()) + " oscillating modes");
+    return modes[static_cast<size_t>(k - 1)].first;
+  }
   if (s.kind == Quantity::Kind::Mode) {
     if (k > model.flexible_dofs())
       throw CaseError("--quantity " + s.text + ": n = " + std::to_string(n) + " has only " + std::to_string(model.flexible_dofs()) + " modes");

@@ -2,6 +2,8 @@
 // The scalar quantities of a refinement study, typed (README, "Quantities", has the table):
 //   static and modal:  [LINK/]tip:ux|uy|uz|rx|ry|rz     static tip of a link (default: the last)
 //                      mode:K, axial:K, bending-y:K, bending-z:K, torsion:K   K-th frequency [Hz]
+//                      linear:K             K-th frequency [Hz] of the linear model about rest
+//                                           (studies/linearize.hpp: free joints move with it)
 //   dynamic:           AGG:SERIES[WINDOW]   AGG = peak (max |x|), max, min, rms, mean over the run
 //                                            or over WINDOW = [t1:t2] (times in s)
 //                      SERIES@T             the value at output time T
@@ -38,6 +40,7 @@ struct Quantity {
     Tip,         ///< static tip component `component` (0–5) of link `link`
     Mode,        ///< the K-th frequency
     ModeOfKind,  ///< the K-th frequency of kind `mode_kind`
+    LinearMode,  ///< the K-th frequency of the linear model about rest (rfem linearize)
     Aggregate,   ///< `aggregate` of the series over [t1, t2]
     AtTime,      ///< the series at output time `time`
   };

@@ -78,9 +78,10 @@ PY
 "$rfem" --threads 1 run "$src/cases/kane_spinup.toml" --accuracy 1e-3 -o acc.h5 --json > acc.json 2>/dev/null
 "$rfem" modes "$src/cases/kane_beam.toml" --accuracy 1e-4 --count 3 -o accm.h5 --json > accm.json
 "$rfem" static "$src/cases/kane_beam.toml" --accuracy tip:uz=1e-6 --json > accs.json
+"$rfem" linearize "$src/cases/two_link_arm.toml" --accuracy 1e-3 -o accl.h5 --json > accl.json
 /usr/bin/python3 - <<'PY'
 import json, math, sys, h5py
-run, modes, static = (json.load(open(f)) for f in ("acc.json", "accm.json", "accs.json"))
+run, modes, static, lin = (json.load(open(f)) for f in ("acc.json", "accm.json", "accs.json", "accl.json"))
 a = run["accuracy"]
 u1 = next(e for e in a["estimates"] if e["quantity"] == "peak:run/u1")
 f = h5py.File("acc.h5", "r")
@@ -95,6 +96,9 @@ checks = {
     "file: the bar beside the value": d[row, 0] == u1["value"] and d[row, 1] == u1["error"] and d.attrs["met"] == 1,
     "modes: three frequencies with bars, met": m["met"] and len(m["estimates"]) == 3 and all(e["error"] > 0 for e in m["estimates"]),
     "modes: the file has them": h5py.File("accm.h5", "r")["accuracy"].shape == (3, 7),
+    "linearize: six frequencies with bars, the model's own": lin["accuracy"]["met"] and
+        all(abs(e["value"] - f) <= 1e-9 * f for e, f in zip(lin["accuracy"]["estimates"], lin["frequencies_hz"])) and
+        h5py.File("accl.h5", "r")["accuracy"].shape == (6, 7),
     "static: the absolute target on tip:uz": static["accuracy"]["met"] and
         next(e for e in static["accuracy"]["estimates"] if e["quantity"] == "tip:uz")["error"] <= 1e-6,
 }

@@ -426,7 +426,7 @@ def __dir__():
     return sorted(set(globals()) | {"plots", "animate", "linear"})
 
 
-def linearize(case, n=None, state=None, threads=1, equilibrium=True, output=None, dense=False):
+def linearize(case, n=None, state=None, threads=1, equilibrium=True, output=None, dense=False, accuracy=None, max_n=None):
     """The case's linear model (an rfem.LinearModel) about its initial state — the static equilibrium
     of simulation.initial = "static" at t = 0 — or about `state` (an rfem.SimulationState: the same
     model, its time), at rest (equilibrium=True: accelerations zero, u0 the torques that hold it) or on
@@ -443,8 +443,17 @@ def linearize(case, n=None, state=None, threads=1, equilibrium=True, output=None
     lin.state_space() gives (A, B, C, D) for x = (q, q') (dense, up to 3000 states), lin.modes() the
     lowest modes. `output`: an HDF5 file (group "linear": every matrix with its row and column names,
     M, D, K, B as (row, column, value) tables; MATLAB's h5read, h5py, SciPy read it), as
-    `rfem linearize -o`."""
-    return _rfem._linearize(case, n, state, threads, equilibrium, output, "rfem.linearize (Python)", dense)
+    `rfem linearize -o`. accuracy= (as rfem.run's; `rfem linearize --accuracy`): n chosen for the six
+    lowest frequencies of the model about rest; .accuracy has their bars."""
+    if accuracy is not None and state is not None:
+        raise CaseError("--accuracy: a saved state has its own n (give no --state, or no target)")
+    acc = _target(case, "linearize", accuracy, max_n, n) if state is None else None
+    lin = _rfem._linearize(case, acc.n if acc is not None else n, state, threads, equilibrium, output,
+                           "rfem.linearize (Python)", dense)
+    lin.accuracy = acc
+    if acc is not None and output is not None:
+        _rfem._write_accuracy(output, acc)
+    return lin
 
 
 def _frequency_response(self, frequencies, input=None, output=None):

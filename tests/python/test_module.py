@@ -125,6 +125,9 @@ def test_accuracy_on_modes_static_and_run(tmp_path):
         assert code == 2 and err.strip() == "rfem: error: " + str(e.value)
     with pytest.raises(rfem.CaseError):
         rfem.modes(beam, n=16, accuracy=1e-3)
+    lin = rfem.linearize(case_path("two_link_arm.toml"), accuracy=1e-3)
+    assert lin.accuracy.met and len(lin.accuracy) == 6 and lin.accuracy["linear:1"]["value"] == pytest.approx(
+        lin.modes(1)[0][0], rel=1e-9)
 
 
 @pytest.mark.parametrize("bad", ["14_negative_E.toml", "85_unknown_parent.toml", "51_unknown_input_kind.toml",
