@@ -65,6 +65,8 @@ const Estimate* AccuracyResult::find(const std::string& quantity) const {
 
 AccuracySpec target_of(const Case& cs, const std::vector<std::string>& given, int n, int max_n, bool n_starts_ladder) {
   AccuracySpec spec;
+  if (max_n > 0 && given.empty() && !cs.accuracy.given())
+    throw CaseError("--max-n: applies to a target (--accuracy, or the case's [accuracy])");
   if (given.empty()) {
     if (!cs.accuracy.given() || n > 0) return spec;
     spec = cs.accuracy;
@@ -72,8 +74,6 @@ AccuracySpec target_of(const Case& cs, const std::vector<std::string>& given, in
     if (n > 0 && !n_starts_ladder) throw CaseError("--n and --accuracy: give one (the target chooses n)");
     for (const std::string& a : given) add_accuracy(spec, a, "--accuracy");
   }
-  if (max_n > 0 && !spec.given() && given.empty() && !cs.accuracy.given())
-    throw CaseError("--max-n: applies to a target (--accuracy, or the case's [accuracy])");
   if (max_n > 0) spec.max_n = max_n;
   return spec;
 }

@@ -117,6 +117,7 @@ TEST(Accuracy, FarFromTheAsymptoticRangeNoBarAndBadTargetsAreRefused) {
   EXPECT_TRUE(target_of(t, {}, 0, 0).given());
   EXPECT_FALSE(target_of(t, {}, 16, 0).given());  // (an explicit n wins over the case's target)
   EXPECT_THROW(target_of(t, {"1e-3"}, 16, 0), CaseError);
+  EXPECT_THROW(target_of(c, {}, 0, 64), CaseError);  // (--max-n without a target)
   EXPECT_THROW(parse_case(beam + "[accuracy]\nrelative = 0\n"), CaseError);
   EXPECT_THROW(parse_case(beam + "[accuracy]\nrelativ = 1e-3\n"), CaseError);
 }
