@@ -151,12 +151,13 @@ std::vector<std::string> shortfall(const RefineResult& res, const RefineRequest&
 }
 
 // With a relative target: tightens the study's tolerances (from tolerances_for_target, tenfold each
-// time, at most kTightenings times) until the time error at the first n — against a rerun at
+// time, in at most kTries tries) until the time error at the first n — against a rerun at
 // tolerances 100 times tighter — is at most kTimeShare of each quantity's allowed bar: a ladder that
-// meets its target ends on a change above about 0.6 of the bar (the level before did not meet
-// it), which then stands ten times clear of the time error, as assess_refinement asks. The time error depends on the motion far more than on n,
-// which is why the cheapest n measures it. Returns false if the study was stopped.
-constexpr int kTightenings = 4;
+// meets its target ends on a change above about 0.6 of the bar (the level before did not meet it),
+// which then stands ten times clear of the time error, as assess_refinement asks. The time error
+// depends on the motion far more than on n, which is why the cheapest n measures it. Returns false
+// if the study was stopped.
+constexpr int kTries = 4;
 constexpr double kTimeShare = 0.05;
 bool calibrate_tolerances(Case& study, int n0, const std::vector<JointInput>& inputs, const RefineRequest& rq,
                           RefineResult& res) {
@@ -179,7 +180,7 @@ bool calibrate_tolerances(Case& study, int n0, const std::vector<JointInput>& in
     res.calibration.push_back(fmt::format("n = {}, rtol {:g}, atol {:g}: time error {:.2g} of the allowed bar{}", n0,
                                           study.sim.options.rtol, study.sim.options.atol, worst,
                                           worst <= kTimeShare ? fmt::format(" (at most {:g}: kept)", kTimeShare) : ""));
-    if (worst <= kTimeShare || attempt + 1 == kTightenings) return true;
+    if (worst <= kTimeShare || attempt + 1 == kTries) return true;
     study.sim.options = tightened(study.sim.options, 10);
   }
   res.status = RunStatus::interrupted(rq.stop.signal());
