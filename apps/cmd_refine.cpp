@@ -98,8 +98,8 @@ int run_refine(const Common& c, const RefineOptions& ro, const ModesOptions& o) 
     if (!rq.modes.empty()) fmt::print(stderr, "[{}/{}] {}\n", i + 1, count, n ? fmt::format("modes = {}", n) : std::string("full model"));
     else if (count == 0 || i < 0) ladder(i, count, n);
     else if (i < count) fmt::print(stderr, "[{}/{}] n = {}\n", i + 1, count, n);
-    else fmt::print(stderr, "[check] n = {} at rtol {:g}\n", n,
-                    (targeted && rq.accuracy ? tolerances_for_target(cs.sim.options, *rq.accuracy) : cs.sim.options).rtol / 100);
+    else if (targeted) ladder(i, count, n);  // (the tolerances were chosen: the rerun is 100 times tighter than those)
+    else fmt::print(stderr, "[check] n = {} at rtol {:g}\n", n, cs.sim.options.rtol / 100);
   };
   const RefineResult res = path.empty() ? refine(cs, rq) : refine_into_file(cs, rq, path, c.command_line);
   progress.clear();

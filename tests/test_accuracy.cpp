@@ -100,6 +100,7 @@ TEST(Accuracy, FarFromTheAsymptoticRangeNoBarAndBadTargetsAreRefused) {
   try {
     AccuracySpec spec;
     add_accuracy(spec, "1e-12");
+    ADD_FAILURE() << "a target of 1e-12 was accepted";
   } catch (const CaseError& e) {
     EXPECT_NE(std::string(e.what()).find("below what rfem can certify"), std::string::npos) << e.what();
   }
