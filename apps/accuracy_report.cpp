@@ -9,7 +9,7 @@
 namespace rfem::app {
 
 AccuracySpec accuracy_target(const Case& cs, const Common& c, bool n_starts_ladder) {
-  return target_of(cs, c.accuracy, c.n, c.max_n, n_starts_ladder);
+  return target_of(cs, c.accuracy, c.n, c.max_n, c.max_time, n_starts_ladder);
 }
 
 std::function<void(int, int, int)> ladder_lines(const AccuracySpec& spec, bool quiet) {

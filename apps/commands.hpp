@@ -33,6 +33,7 @@ struct Common {
   /// --accuracy (repeatable): a relative target ("1e-3") or QUANTITY=ERROR; replaces the case's [accuracy].
   std::vector<std::string> accuracy;
   int max_n = 0;         ///< --max-n (0: the target's, else kMaxTargetN)
+  double max_time = 0.0; ///< --max-time [s] (0: the target's, else none)
 };
 
 struct ModesOptions {

@@ -37,21 +37,30 @@ CLI::Validator positive_int(long max) {
       "POSITIVE");
 }
 const CLI::Validator kPositiveInt = positive_int(100000000);
+// The whole text as a finite number, or NaN.
+double finite_number(const std::string& s) {
+  size_t used = 0;
+  double v = NAN;
+  try {
+    v = std::stod(s, &used);
+  } catch (...) {
+    used = 0;
+  }
+  return used == 0 || used != s.size() || !std::isfinite(v) ? NAN : v;
+}
 // A finite number ≥ 0 (CLI11's NonNegativeNumber lets "nan" through).
 const CLI::Validator kNonNegativeFinite(
     [](std::string& s) -> std::string {
-      size_t used = 0;
-      double v = NAN;
-      try {
-        v = std::stod(s, &used);
-      } catch (...) {
-        used = 0;
-      }
-      if (used == 0 || used != s.size() || !std::isfinite(v) || v < 0) return "must be a finite number, 0 or more (got '" + s + "')";
-      return "";
+      return finite_number(s) >= 0 ? "" : "must be a finite number, 0 or more (got '" + s + "')";
     },
     "NONNEGATIVE");
 const CLI::Validator kRfes = positive_int(rfem::kMaxRfes);  // the case file's own limit
+// A finite number > 0 of seconds (--max-time).
+const CLI::Validator kPositiveSeconds(
+    [](std::string& s) -> std::string {
+      return finite_number(s) > 0 ? "" : "must be a positive number of seconds (got '" + s + "')";
+    },
+    "SECONDS");
 
 }  // namespace
 
@@ -85,6 +94,10 @@ int main(int argc, char** argv) {
         ->delimiter(',');
     sub->add_option("--max-n", common.max_n, fmt::format("the largest n a target may reach (default {})", rfem::kMaxTargetN))
         ->check(kRfes);
+    sub->add_option("--max-time", common.max_time,
+                    "wall time a command with a target may take [s]: its ladder stops before an n predicted to end past it "
+                    "(default: none)")
+        ->check(kPositiveSeconds);
   };
   ModesOptions mo;
   auto add_rate = [&](CLI::App* sub) {

@@ -23,6 +23,9 @@ struct AccuracySpec {
   double relative = 0.0;
   std::vector<AbsoluteTarget> absolute;  ///< named quantities with an absolute bar
   int max_n = 0;                         ///< the largest n the ladder may reach (0: kMaxTargetN)
+  /// Wall time the ladder may take [s] (0: no limit): it stops before an n whose predicted end
+  /// (the elapsed time plus that n's cost, extrapolated from the levels done) would pass it.
+  double max_time = 0.0;
   bool given() const { return relative > 0.0 || !absolute.empty(); }
 };
 

@@ -146,11 +146,11 @@ SimulationSettings read_simulation(const Reader& r, const toml::table& t) {
   return s;
 }
 
-// [accuracy]: relative = 1e-3, max_n = N, [accuracy.absolute] "peak:u1" = 2e-4 (cases/accuracy_spec.hpp).
+// [accuracy]: relative = 1e-3, max_n = N, max_time = S, [accuracy.absolute] "peak:u1" = 2e-4 (cases/accuracy_spec.hpp).
 AccuracySpec read_accuracy(const Reader& r, const toml::node* an, const std::string& path) {
   if (!an->is_table()) r.fail(an, "accuracy", "must be a table (relative = 1e-3, max_n, [accuracy.absolute])");
   const toml::table& t = *an->as_table();
-  r.check_keys(t, "accuracy", {"relative", "max_n", "absolute"});
+  r.check_keys(t, "accuracy", {"relative", "max_n", "max_time", "absolute"});
   AccuracySpec a;
   auto where = [&](const toml::node* n, const std::string& key) {
     return path + (n && n->source().begin.line > 0 ? ":" + std::to_string(n->source().begin.line) : std::string()) + ": " + key;
@@ -161,6 +161,7 @@ AccuracySpec read_accuracy(const Reader& r, const toml::node* an, const std::str
     a.relative = v;
   }
   a.max_n = static_cast<int>(r.integer(t, "accuracy", "max_n", 0, 2, kMaxRfes));
+  if (t.get("max_time")) a.max_time = r.positive(t, "accuracy", "max_time", 0.0);
   if (const toml::node* n = t.get("absolute")) {
     if (!n->is_table()) r.fail(n, "accuracy.absolute", "must be a table of QUANTITY = ERROR, e.g. \"peak:u1\" = 2e-4");
     for (const auto& [k, v] : *n->as_table()) {

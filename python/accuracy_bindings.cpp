@@ -67,14 +67,16 @@ void bind_accuracy(py::module_& m) {
       });
 
   m.def("_accuracy", [](args::Typed<"Union[Case, str, os.PathLike]"> case_arg, args::Typed<"str"> command_arg,
-                        args::Typed<"Optional[List[str]]"> accuracy, args::Typed<"Optional[int]"> max_n, args::Typed<"Optional[int]"> n_arg,
+                        args::Typed<"Optional[List[str]]"> accuracy, args::Typed<"Optional[int]"> max_n,
+                        args::Typed<"Optional[float]"> max_time, args::Typed<"Optional[int]"> n_arg,
                         args::Typed<"int"> count, args::Typed<"Optional[float]"> rate, args::Typed<"int"> joint,
                         args::Typed<"int"> threads, args::Typed<"Optional[Callable[[dict], Any]]"> progress) {
     const args::CaseArg cs_arg(case_arg);
     const Case& cs = *cs_arg;
     const std::string command = py::str(command_arg);
     const std::vector<std::string> given = accuracy.is_none() ? std::vector<std::string>{} : args::texts(accuracy, "accuracy");
-    const AccuracySpec target = target_of(cs, given, args::rfes(n_arg), max_n.is_none() ? 0 : args::rfes(max_n, "max_n"));
+    const AccuracySpec target = target_of(cs, given, args::rfes(n_arg), max_n.is_none() ? 0 : args::rfes(max_n, "max_n"),
+                                          args::seconds(max_time, "max_time"));
     if (!target.given()) return py::make_tuple(py::none(), py::none());
     Reported reported;
     RefineRequest base;
@@ -100,7 +102,7 @@ void bind_accuracy(py::module_& m) {
     a->warnings.insert(a->warnings.end(), warnings.begin(), warnings.end());
     py::object error = pending->take();  // (Ctrl-C: rfem._raise turns it into RunInterrupted)
     return py::make_tuple(py::cast(a), error);
-  }, py::arg("case"), py::arg("command"), py::arg("accuracy"), py::arg("max_n"), py::arg("n"), py::arg("count"), py::arg("rate"),
+  }, py::arg("case"), py::arg("command"), py::arg("accuracy"), py::arg("max_n"), py::arg("max_time"), py::arg("n"), py::arg("count"), py::arg("rate"),
      py::arg("joint"), py::arg("threads"), py::arg("progress"));
 
   m.def("_write_accuracy", [](args::Typed<"Union[str, os.PathLike]"> path, const AccuracyResult& a) {

@@ -125,6 +125,14 @@ inline double non_negative(py::handle v, const std::string& name, const std::str
   return x;
 }
 
+/// None (0: no limit) or a positive, finite number of seconds.
+inline double seconds(py::handle v, const std::string& name) {
+  if (v.is_none()) return 0.0;
+  const double x = real(v, name, "a positive number of seconds");
+  if (!(x > 0)) value_error(name, "a positive number of seconds", v);
+  return x;
+}
+
 /// None or a finite real.
 inline std::optional<double> optional_real(py::handle v, const std::string& name, const std::string& what = "a finite number") {
   if (v.is_none()) return std::nullopt;

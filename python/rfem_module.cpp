@@ -470,7 +470,8 @@ PYBIND11_MODULE(_rfem, m) {
 
   m.def("_refine", [](args::Typed<"Union[Case, str, os.PathLike]"> case_arg, args::Typed<"List[int]"> ns, args::Typed<"List[str]"> quantity_args, args::Typed<"Optional[Union[str, os.PathLike]]"> output_arg,
                       args::Typed<"bool"> integration_check, args::Typed<"Optional[float]"> rate, args::Typed<"int"> joint, args::Typed<"int"> threads, args::Typed<"Optional[Callable[[dict], Any]]"> progress,
-                      args::Typed<"Optional[List[int]]"> modes, args::Typed<"Optional[List[str]]"> accuracy, args::Typed<"Optional[int]"> max_n) {
+                      args::Typed<"Optional[List[int]]"> modes, args::Typed<"Optional[List[str]]"> accuracy, args::Typed<"Optional[int]"> max_n,
+                      args::Typed<"Optional[float]"> max_time) {
     const args::CaseArg cs_arg(case_arg);
     const Case& cs = *cs_arg;
     const std::vector<std::string> quantities = args::texts(quantity_args, "quantities");
@@ -483,7 +484,8 @@ PYBIND11_MODULE(_rfem, m) {
     rq.quantities = quantities;
     // A target (as rfem refine): accuracy=, or the case's [accuracy] for a study without a ladder of its own.
     const std::vector<std::string> given = accuracy.is_none() ? std::vector<std::string>{} : args::texts(accuracy, "accuracy");
-    const AccuracySpec target = target_of(cs, given, 0, max_n.is_none() ? 0 : args::rfes(max_n, "max_n"), true);
+    const AccuracySpec target =
+        target_of(cs, given, 0, max_n.is_none() ? 0 : args::rfes(max_n, "max_n"), args::seconds(max_time, "max_time"), true);
     if (target.given() && (!given.empty() || (rq.modes.empty() && rq.ns.size() < 2))) apply_target(cs, target, rq);
     rq.integration_check = args::flag(integration_check, "integration_check");
     rq.rate = args::joint_rate(rate, joint);
@@ -510,6 +512,7 @@ PYBIND11_MODULE(_rfem, m) {
       out["rtol"] = res.rtol;
       out["atol"] = res.atol;
       out["calibration"] = res.calibration;
+      out["time_limit"] = res.time_limit;
     }
     py::list tables;
     for (size_t k = 0; k < res.tables.size(); ++k) {
@@ -540,7 +543,7 @@ PYBIND11_MODULE(_rfem, m) {
     return py::make_tuple(out, error);
   }, py::arg("case"), py::arg("ns"), py::arg("quantities"), py::arg("output"), py::arg("integration_check"),
      py::arg("rate"), py::arg("joint"), py::arg("threads"), py::arg("progress"), py::arg("modes"), py::arg("accuracy"),
-     py::arg("max_n"));
+     py::arg("max_n"), py::arg("max_time"));
   bind_sweep(m);
   bind_simulation(m);
   bind_accuracy(m);

@@ -98,6 +98,11 @@ void write_attribute(hid_t obj, const std::string& key, const std::string& value
 
 void write_attribute(hid_t obj, const std::string& key, const std::vector<std::string>& values) {
   const Handle t = string_type();
+  if (values.empty()) {  // an empty list (a structure without joints): a null dataspace, nothing to write
+    const Handle s = space(H5Screate(H5S_NULL), "attribute " + key);
+    const Handle a = new_attribute(obj, key, t, s);
+    return;
+  }
   const hsize_t dims[1] = {values.size()};
   const Handle s = space(H5Screate_simple(1, dims, nullptr), "attribute " + key);
   const Handle a = new_attribute(obj, key, t, s);

@@ -198,7 +198,8 @@ RunResult RunBook::end(RunOutcome r) {
 
 void check_runnable(const Case& cs) {
   if (!cs.has_simulation) throw CaseError(cs.path + ": simulation: missing table (t_end, output_dt, …) for a run");
-  if (cs.joints.empty()) throw CaseError(cs.path + ": joints: a run needs at least one base joint");
+  // A case without joints runs too: its links are clamped to the ground (a structure vibrating
+  // under gravity or from an undeformed start; its linear model is rfem modes' M, D, K).
 }
 
 }  // namespace rfem

@@ -196,7 +196,7 @@ class RunBook {
   std::chrono::steady_clock::time_point t0_;
 };
 
-/// CaseError unless the case can be run: a [simulation] table and at least one joint.
+/// CaseError unless the case can be run: a [simulation] table (a case without joints runs clamped).
 void check_runnable(const Case& cs);
 
 }  // namespace rfem

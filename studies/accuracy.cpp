@@ -63,10 +63,15 @@ const Estimate* AccuracyResult::find(const std::string& quantity) const {
   return nullptr;
 }
 
-AccuracySpec target_of(const Case& cs, const std::vector<std::string>& given, int n, int max_n, bool n_starts_ladder) {
+AccuracySpec target_of(const Case& cs, const std::vector<std::string>& given, int n, int max_n, double max_time,
+                       bool n_starts_ladder) {
   AccuracySpec spec;
   if (max_n > 0 && given.empty() && !cs.accuracy.given())
     throw CaseError("--max-n: applies to a target (--accuracy, or the case's [accuracy])");
+  if (max_time != 0.0 && !(max_time > 0.0 && std::isfinite(max_time)))
+    throw CaseError("--max-time: must be a positive number of seconds (got " + fmt::format("{}", max_time) + ")");
+  if (max_time > 0.0 && given.empty() && !cs.accuracy.given())
+    throw CaseError("--max-time: applies to a target (--accuracy, or the case's [accuracy])");
   if (given.empty()) {
     if (!cs.accuracy.given() || n > 0) return spec;
     spec = cs.accuracy;
@@ -75,6 +80,7 @@ AccuracySpec target_of(const Case& cs, const std::vector<std::string>& given, in
     for (const std::string& a : given) add_accuracy(spec, a, "--accuracy");
   }
   if (max_n > 0) spec.max_n = max_n;
+  if (max_time > 0.0) spec.max_time = max_time;
   return spec;
 }
 
@@ -103,6 +109,7 @@ void apply_target(const Case& cs, const AccuracySpec& target, RefineRequest& rq)
   if (target.relative > 0.0) rq.accuracy = target.relative;
   else rq.accuracy.reset();
   rq.max_n = target.max_n > 0 ? target.max_n : kMaxTargetN;
+  rq.max_time = target.max_time;
 }
 
 AccuracyResult meet_accuracy(const Case& cs, const AccuracySpec& target, const Reported& reported, RefineRequest rq) {

@@ -63,9 +63,11 @@ struct AccuracyResult {
 
 /// A command's target: the texts given (add_accuracy: "1e-3", "peak:u1=2e-4"; they replace the
 /// case's [accuracy]), else the case's [accuracy] unless an n is given (the caller's choice wins);
-/// `max_n` > 0 replaces the target's. None (given() false) if neither. CaseError for an n with given
-/// texts unless `n_starts_ladder` (a refinement's --n is where its ladder starts).
-AccuracySpec target_of(const Case& cs, const std::vector<std::string>& given, int n, int max_n, bool n_starts_ladder = false);
+/// `max_n` > 0 and `max_time` > 0 [s] replace the target's. None (given() false) if neither. CaseError
+/// for an n with given texts unless `n_starts_ladder` (a refinement's --n is where its ladder starts),
+/// for a limit without a target, and for a max_time that is not positive and finite.
+AccuracySpec target_of(const Case& cs, const std::vector<std::string>& given, int n, int max_n, double max_time = 0.0,
+                       bool n_starts_ladder = false);
 /// Sets a refinement's targets (relative, absolute — a quantity named only by an absolute target
 /// is added —, max_n) from `target`; CaseError for a bad target or an unknown quantity.
 void apply_target(const Case& cs, const AccuracySpec& target, RefineRequest& rq);

@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 
@@ -121,6 +122,10 @@ LadderState ladder_state(const std::vector<int>& ns, const std::vector<std::vect
   return met ? LadderState::Met : stalled ? LadderState::Stalled : LadderState::Going;
 }
 
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 // Per quantity that misses its target: why, and by how much (the n that would meet it, from the
 // observed order, when the bar is there but too wide).
 std::vector<std::string> shortfall(const RefineResult& res, const RefineRequest& rq) {
@@ -135,7 +140,8 @@ std::vector<std::string> shortfall(const RefineResult& res, const RefineRequest&
                                     "order (an erratic series, e.g. a peak read on the output grid); not certified",
                                     t.rows.back().change, t.rows[t.rows.size() - 2].change, want));
     } else if (!t.asymptotic) {
-      out.push_back(q + "no error bar (the series is not in the asymptotic range; see the warnings)");
+      out.push_back(q + "no error bar (the series is not in the asymptotic range; see the warnings)" +
+                    (res.time_limit.empty() ? std::string() : "; stopped: " + res.time_limit));
     } else if (std::isfinite(t.error_time) && t.error_time > want) {
       out.push_back(q + fmt::format("the time error {:.3g} alone is above the target {:.3g}: tighten simulation.rtol and atol",
                                     t.error_time, want));
@@ -143,8 +149,9 @@ std::vector<std::string> shortfall(const RefineResult& res, const RefineRequest&
       const double p = std::min(t.observed_order(), kTheoreticalOrder);
       const double room = want - (std::isfinite(t.error_time) ? t.error_time : 0.0);
       const double n = res.ns.back() * std::pow(t.error_space / room, 1.0 / p);
-      out.push_back(q + fmt::format("the bar {:.3g} is {:.3g} times the target {:.3g}; n ≈ {:.0f} would meet it, above --max-n {}",
-                                    t.error, t.error / want, want, std::ceil(n), rq.max_n));
+      const std::string limit = res.time_limit.empty() ? fmt::format("above --max-n {}", rq.max_n) : "stopped: " + res.time_limit;
+      out.push_back(q + fmt::format("the bar {:.3g} is {:.3g} times the target {:.3g}; n ≈ {:.0f} would meet it, {}", t.error,
+                                    t.error / want, want, std::ceil(n), limit));
     }
   }
   return out;
@@ -293,6 +300,7 @@ std::vector<Quantity> check_refinement(const Case& cs, const RefineRequest& rq) 
 }
 
 RefineResult refine(const Case& cs, const RefineRequest& rq) {
+  const auto started = std::chrono::steady_clock::now();
   RefineResult res;
   res.quantities = check_refinement(cs, rq);
   const std::vector<Quantity>& qs = res.quantities;
@@ -314,15 +322,31 @@ RefineResult refine(const Case& cs, const RefineRequest& rq) {
   std::vector<double> integration(qs.size(), 0.0);  // (none in a static or modal value)
   for (size_t k = 0; k < qs.size(); ++k)
     if (qs[k].dynamic()) integration[k] = NAN;  // (not measured, unless checked below)
+  std::vector<double> level_s;  // wall time of each level
   for (size_t i = 0;; ++i) {
     if (i == ladder.size()) {  // a target: three levels at least, then until the bars meet it
       if (!targeted || (ladder.size() >= 3 && ladder_state(res.ns, values, integration, rq) != LadderState::Going)) break;
       if (2 * ladder.back() > rq.max_n) break;
+      if (rq.max_time > 0.0) {
+        // The next level's cost: the last one's times its growth (at least linear in n). After it
+        // come, at that n, the integration check (100× tighter: ~2× a level with ESDIRK5) and the
+        // command's own run: 4 levels' cost in all for dynamic values, 2 for static and modal ones.
+        const size_t L = level_s.size();
+        const double growth = L >= 2 && level_s[L - 2] > 0.0 ? std::max(2.0, level_s[L - 1] / level_s[L - 2]) : 2.0;
+        const double end = seconds_since(started) + level_s.back() * growth * (res.dynamic ? 4.0 : 2.0);
+        if (end > rq.max_time) {
+          res.time_limit = fmt::format("n = {} would end at about {:.3g} s, past --max-time {:g} s", 2 * ladder.back(), end,
+                                       rq.max_time);
+          break;
+        }
+      }
       ladder.push_back(2 * ladder.back());
     }
     const int n = ladder[i];
     if (rq.on_n) rq.on_n(static_cast<int>(i), targeted ? 0 : static_cast<int>(ladder.size()), n);
+    const auto level_start = std::chrono::steady_clock::now();
     if (!evaluate_point(study, n, inputs, fmt::format("n{}/", n), "n = " + std::to_string(n), rq, res, values)) break;
+    level_s.push_back(seconds_since(level_start));
     res.ns.push_back(n);
   }
   // The integration error of the finest run: the same n at tolerances 100 times tighter.

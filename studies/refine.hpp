@@ -38,6 +38,11 @@ struct RefineRequest {
   /// Quantities that share a scale for the relative target (one id per quantity; empty: each its own).
   std::vector<int> groups;
   int max_n = kMaxTargetN;
+  /// Wall time a command with a target may take [s] (0: none): its ladder stops before an n whose
+  /// predicted end would pass it (that n's cost from the last two levels' growth, at least linear,
+  /// 4 times over for dynamic values — the level, the integration check, the command's run —, twice
+  /// for static and modal ones).
+  double max_time = 0.0;
   JointRate rate;                       ///< for static and modal quantities
   int threads = 0;
   StopToken stop;                       ///< ends the study after the current run; rows done are kept
@@ -63,6 +68,9 @@ struct RefineResult {
   /// that did not, why and by how much (one line each: not success).
   bool met = false;
   std::vector<std::string> shortfall;
+  /// Why a ladder towards a target stopped short of it, if a limit did ("" otherwise): the next n,
+  /// its predicted end and max_time, when the wall-time limit did.
+  std::string time_limit;
   std::vector<double> allowed;         ///< with a target: each quantity's bar must be ≤ this (inf: no target)
   /// Per quantity: zero at every n, to 1e-12 of its group's scale (by the case's symmetry): no bar needed.
   std::vector<bool> zero;

@@ -40,8 +40,7 @@ Sweep read_sweep(const std::string& path, const std::string& index) {
     const std::string where = path + ": " + sweep_point_name(s, static_cast<int>(k)) + ": ";
     try {
       const Case c = with_overrides(base, sweep_case_overrides(s, static_cast<int>(k)));
-      if (!c.has_simulation) throw CaseError(c.path + ": simulation: missing table (t_end, output_dt, …) for a run");
-      if (c.joints.empty()) throw CaseError(c.path + ": joints: a run needs at least one base joint");
+      check_runnable(c);
       const int n = sweep_point_n(s, static_cast<int>(k));
       int rfes = 0;
       for (const auto& lp : link_parts(c, n)) rfes = std::accumulate(lp.begin(), lp.end(), rfes);

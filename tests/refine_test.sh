@@ -114,4 +114,14 @@ set +e; err=$("$rfem" modes "$src/cases/kane_beam.toml" --accuracy 1e-3 --n 16 2
 [ "$code" = 2 ] && [ "$(printf '%s\n' "$err" | wc -l)" = 1 ] || { echo "FAIL --n with --accuracy: exit $code: $err"; exit 1; }
 set +e; "$rfem" modes "$src/cases/kane_beam.toml" --accuracy 1e-8 --max-n 32 -q > /dev/null; code=$?; set -e
 [ "$code" = 3 ] || { echo "FAIL: modes with a target not met exits $code (want 3)"; exit 1; }
+# A wall-time limit: bad values and a limit without a target are one line, exit 2; a limit no level
+# after the first fits in stops the ladder, and the target is not met (exit 3, the reason printed).
+for bad in "0" "-1" "nan" "abc"; do
+  set +e; err=$("$rfem" modes "$src/cases/kane_beam.toml" --accuracy 1e-4 --max-time "$bad" 2>&1 >/dev/null); code=$?; set -e
+  [ "$code" = 2 ] && [ "$(printf '%s\n' "$err" | wc -l)" = 1 ] || { echo "FAIL --max-time $bad: exit $code: $err"; exit 1; }
+done
+set +e; err=$("$rfem" modes "$src/cases/kane_beam.toml" --max-time 10 2>&1 >/dev/null); code=$?; set -e
+[ "$code" = 2 ] && [ "$(printf '%s\n' "$err" | wc -l)" = 1 ] || { echo "FAIL --max-time without a target: exit $code: $err"; exit 1; }
+set +e; out=$("$rfem" modes "$src/cases/kane_beam.toml" --accuracy 1e-4 --max-time 1e-6 2>/dev/null); code=$?; set -e
+[ "$code" = 3 ] && printf '%s\n' "$out" | grep -q "past --max-time" || { echo "FAIL: --max-time 1e-6 exits $code: $out"; exit 1; }
 echo "refine: all passed"

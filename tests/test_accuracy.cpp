@@ -119,6 +119,11 @@ TEST(Accuracy, FarFromTheAsymptoticRangeNoBarAndBadTargetsAreRefused) {
   EXPECT_FALSE(target_of(t, {}, 16, 0).given());  // (an explicit n wins over the case's target)
   EXPECT_THROW(target_of(t, {"1e-3"}, 16, 0), CaseError);
   EXPECT_THROW(target_of(c, {}, 0, 64), CaseError);  // (--max-n without a target)
+  EXPECT_THROW(target_of(c, {}, 0, 0, 10.0), CaseError);  // (--max-time without a target)
+  for (double bad : {-1.0, double(NAN), double(INFINITY)}) EXPECT_THROW(target_of(t, {}, 0, 0, bad), CaseError) << bad;
+  EXPECT_EQ(target_of(t, {}, 0, 0, 10.0).max_time, 10.0);
+  EXPECT_EQ(parse_case(beam + "[accuracy]\nrelative = 1e-3\nmax_time = 60\n").accuracy.max_time, 60.0);
+  EXPECT_THROW(parse_case(beam + "[accuracy]\nrelative = 1e-3\nmax_time = 0\n"), CaseError);
   EXPECT_THROW(parse_case(beam + "[accuracy]\nrelative = 0\n"), CaseError);
   EXPECT_THROW(parse_case(beam + "[accuracy]\nrelativ = 1e-3\n"), CaseError);
 }
@@ -167,6 +172,25 @@ TEST(Accuracy, ATargetNoNUpToTheLimitMeetsIsReportedShortByHowMuch) {
   EXPECT_EQ(res.ns, (std::vector<int>{8, 16, 32, 64}));
   ASSERT_EQ(res.shortfall.size(), 1u);
   EXPECT_NE(res.shortfall[0].find("n ≈"), std::string::npos) << res.shortfall[0];
+  EXPECT_TRUE(res.time_limit.empty());
+  // A wall-time limit instead: no level after the first fits in a microsecond, so the ladder stops
+  // there, says why in the shortfall, and is not met; a limit it does not reach changes nothing.
+  RefineRequest timed = rq;
+  timed.accuracy = 1e-4;
+  timed.max_n = kMaxTargetN;
+  timed.max_time = 1e-6;
+  const RefineResult stopped = refine(c, timed);
+  EXPECT_FALSE(stopped.met);
+  EXPECT_EQ(stopped.ns, (std::vector<int>{8}));
+  ASSERT_EQ(stopped.shortfall.size(), 1u);
+  EXPECT_NE(stopped.shortfall[0].find("past --max-time"), std::string::npos) << stopped.shortfall[0];
+  timed.max_time = 3600.0;
+  RefineRequest untimed = timed;
+  untimed.max_time = 0.0;
+  const RefineResult a = refine(c, timed), b = refine(c, untimed);
+  EXPECT_TRUE(a.met);
+  EXPECT_EQ(a.ns, b.ns);
+  EXPECT_TRUE(a.time_limit.empty());
   // A target of 0, NaN or ≥ 1, and a target over a series of modes: one line, before any work.
   for (double bad : {0.0, double(NAN), 1.0, -1e-3}) {
     rq.accuracy = bad;

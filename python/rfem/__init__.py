@@ -151,9 +151,10 @@ def _accuracy_texts(accuracy):
                     f"not {type(accuracy).__name__}")
 
 
-def _target(case, command, accuracy, max_n, n, count=6, rate=None, joint=1, threads=0, progress=None):
+def _target(case, command, accuracy, max_n, n, count=6, rate=None, joint=1, threads=0, progress=None, max_time=None):
     """The Accuracy a target asks for (accuracy=, or the case's [accuracy] without n), or None."""
-    acc, error = _rfem._accuracy(case, command, _accuracy_texts(accuracy), max_n, n, count, rate, joint, threads, progress)
+    acc, error = _rfem._accuracy(case, command, _accuracy_texts(accuracy), max_n, max_time, n, count, rate, joint, threads,
+                                 progress)
     _raise(error, acc)
     return acc
 
@@ -194,7 +195,8 @@ class Runs(list):
 
 
 def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, progress=None, resume=None,
-        checkpoint=_rfem.CHECKPOINT_INTERVAL, controller=None, sample_time=None, delay=0, accuracy=None, max_n=None):
+        checkpoint=_rfem.CHECKPOINT_INTERVAL, controller=None, sample_time=None, delay=0, accuracy=None, max_n=None,
+        max_time=None):
     """Runs the case's [simulation] by its procedure (single: "run"; paper: "rigid", "kinematic",
     "force") and returns the Runs.
 
@@ -217,7 +219,8 @@ def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, 
     checkpoint:  seconds of wall time between checkpoints written into `output` (0: none)
     accuracy:    a target instead of n (`rfem run --accuracy`; the case's [accuracy] applies without
                  n): 1e-3 (relative to each peak's scale), "peak:force/u1=2e-4" or {"peak:u1": 2e-4}
-                 (absolute), or a list; rfem chooses the tolerances and n (up to max_n, default 2048)
+                 (absolute), or a list; rfem chooses the tolerances and n (up to max_n, default 2048;
+                 max_time: seconds the ladder may take, it stops before an n predicted to end past it)
                  and the Runs carry .accuracy (rfem.Accuracy: each peak with its error bar; .met)
 
     A run that fails has status "failed: …" (the outputs before kept); Ctrl-C raises
@@ -241,7 +244,7 @@ def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, 
         result = Runs([run_controlled(case, controller, sample_time, n=n, delay=delay, output=output, threads=threads,
                                       keep_series=keep_series)])
         return result
-    acc = _target(case, "run", accuracy, max_n, n, threads=threads, progress=progress)
+    acc = _target(case, "run", accuracy, max_n, n, threads=threads, progress=progress, max_time=max_time)
     if acc is not None:
         if runs is not None:
             raise ValueError("rfem.run(accuracy=...) runs the whole procedure: no runs with it")
@@ -286,25 +289,25 @@ def show(case, n=None):
     return tree
 
 
-def static(case, n=None, rate=None, joint=1, accuracy=None, max_n=None):
+def static(case, n=None, rate=None, joint=1, accuracy=None, max_n=None, max_time=None):
     """Static equilibrium with the joints held at their values (or turning steadily: `rate`
     [rad/s or m/s] of joint `joint`, from 1) under gravity and the case's tip loads. Returns a
     StaticResult (tips per link, energies, coordinates). accuracy= (as rfem.run's; `rfem static
     --accuracy`): n chosen for the tips' displacements and rotations; .accuracy has their bars."""
-    acc = _target(case, "static", accuracy, max_n, n, rate=rate, joint=joint)
+    acc = _target(case, "static", accuracy, max_n, n, rate=rate, joint=joint, max_time=max_time)
     result = _rfem._static(case, acc.n if acc is not None else n, rate, joint)
     result.accuracy = acc
     return result
 
 
-def modes(case, n=None, count=6, free=(), rate=None, joint=1, output=None, accuracy=None, max_n=None):
+def modes(case, n=None, count=6, free=(), rate=None, joint=1, output=None, accuracy=None, max_n=None, max_time=None):
     """Natural frequencies and mode shapes of the flexible links about the static equilibrium,
     joints held except those in `free` (numbers from 1, names, or "base"), optionally in a frame
     turning at `rate` about joint `joint`. Returns a ModesResult (frequencies [Hz], kinds,
     shapes, exact references for one uniform segment); `output`: an HDF5 file with the
     frequencies and shapes (group modes, as `rfem modes -o`). accuracy= (as rfem.run's; `rfem
     modes --accuracy`): n chosen for the first `count` frequencies; .accuracy has their bars."""
-    acc = _target(case, "modes", accuracy, max_n, n, count=count, rate=rate, joint=joint)
+    acc = _target(case, "modes", accuracy, max_n, n, count=count, rate=rate, joint=joint, max_time=max_time)
     if acc is not None and free:
         raise CaseError("--accuracy: modes with --free joints are not refined yet; give --n")
     result = _rfem._modes(case, acc.n if acc is not None else n, count, free, rate, joint, output)
@@ -335,7 +338,7 @@ class RefineResult(dict):
 
 
 def refine(case, ns, quantities, output=None, integration_check=True, rate=None, joint=1, threads=0, progress=None,
-           modes=None, accuracy=None, max_n=None):
+           modes=None, accuracy=None, max_n=None, max_time=None):
     """Quantities over an increasing series of n with observed orders and Richardson values
     (the quantities of `rfem refine`: "tip:uz", "bending-y:1", "peak:u1", "force/u1@10", …).
     Dynamic quantities share one run per n; `output` keeps every run and the tables in HDF5.
@@ -345,10 +348,11 @@ def refine(case, ns, quantities, output=None, integration_check=True, rate=None,
     "peak:u1=2e-4", {"peak:u1": 2e-4} or a list): an error bar every quantity must meet instead of a
     fixed series: the tolerances chosen for it (["rtol"], ["atol"], ["calibration"]), n doubles from
     the last of `ns` (or 8, with ns=None) until every table's "error" ≤ its "allowed" or the next n
-    passes max_n (2048); ["met"] says whether it was, ["shortfall"] why not and by how much.
+    passes max_n (2048) or, with max_time (seconds), is predicted to end past it (["time_limit"] says
+    so); ["met"] says whether it was, ["shortfall"] why not and by how much.
     Ctrl-C raises RunInterrupted with the rows done in .result."""
     out, error = _rfem._refine(case, ns, quantities, output, integration_check, rate, joint, threads, progress, modes,
-                               _accuracy_texts(accuracy), max_n)
+                               _accuracy_texts(accuracy), max_n, max_time)
     result = RefineResult(out)
     _raise(error, result)
     return result
@@ -426,7 +430,8 @@ def __dir__():
     return sorted(set(globals()) | {"plots", "animate", "linear"})
 
 
-def linearize(case, n=None, state=None, threads=1, equilibrium=True, output=None, dense=False, accuracy=None, max_n=None):
+def linearize(case, n=None, state=None, threads=1, equilibrium=True, output=None, dense=False, accuracy=None, max_n=None,
+              max_time=None):
     """The case's linear model (an rfem.LinearModel) about its initial state — the static equilibrium
     of simulation.initial = "static" at t = 0 — or about `state` (an rfem.SimulationState: the same
     model, its time), at rest (equilibrium=True: accelerations zero, u0 the torques that hold it) or on
@@ -447,7 +452,7 @@ def linearize(case, n=None, state=None, threads=1, equilibrium=True, output=None
     lowest frequencies of the model about rest; .accuracy has their bars."""
     if accuracy is not None and state is not None:
         raise CaseError("--accuracy: a saved state has its own n (give no --state, or no target)")
-    acc = _target(case, "linearize", accuracy, max_n, n) if state is None else None
+    acc = _target(case, "linearize", accuracy, max_n, n, max_time=max_time) if state is None else None
     lin = _rfem._linearize(case, acc.n if acc is not None else n, state, threads, equilibrium, output,
                            "rfem.linearize (Python)", dense)
     lin.accuracy = acc

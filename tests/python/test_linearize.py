@@ -57,6 +57,25 @@ def test_about_the_equilibrium_the_linear_model_has_rfem_modes(tmp_path):
     assert (back.K != lin.K).nnz == 0 and (back.M != lin.M).nnz == 0
 
 
+def test_a_structure_without_joints_has_a_linear_model(tmp_path):
+    """Kane's clamped beam (cases/kane_beam.toml: no joints, no [simulation] table): the linear
+    model exists (it was refused: "a run needs at least one base joint"), has no inputs, and its
+    generalised eigenvalues are `rfem modes`' frequencies to 1e-8 (the bound of the test above:
+    central differences' round-off in the softest modes). The program writes the same K."""
+    case = rfem.load(case_path("kane_beam.toml"))
+    lin = rfem.linearize(case, n=10)
+    assert len(lin.states) == 60 and lin.inputs == [] and lin.outputs == ["link/tip_u1", "link/tip_u2", "link/tip_theta"]
+    md = rfem.modes(case, n=10, count=6)
+    f = np.sqrt(sl.eigh(lin.K.toarray(), lin.M.toarray(), eigvals_only=True)[:6]) / (2 * np.pi)
+    assert np.abs(f / md.frequencies - 1).max() < 1e-8
+    code = subprocess.run([RFEM, "linearize", case_path("kane_beam.toml"), "--n", "10", "--threads", "1", "-q",
+                           "-o", str(tmp_path / "beam.h5")], capture_output=True, text=True)
+    assert code.returncode == 0, code.stderr
+    with h5py.File(tmp_path / "beam.h5") as b:
+        t = b["linear/K"][()]
+        assert np.array_equal(np.asarray(lin.K.tocoo().todense())[t[:, 0].astype(int), t[:, 1].astype(int)], t[:, 2])
+
+
 def test_a_small_torque_step_answers_as_the_nonlinear_equations_do():
     """The two-link arm under its PD laws, held at its initial equilibrium (reference there, the
     feed-forward the torque that holds it), then a torque step δu on the elbow: the forearm's tip

@@ -99,6 +99,13 @@ def test_static_modes_refine_equal_program():
     assert code == 3 and "NOT met" in out and "n ≈" in out
     short = rfem.refine(rfem.load(case_path("kane_beam.toml")), None, ["mode:1"], accuracy=1e-8, max_n=32)
     assert not short["met"] and len(short["shortfall"]) == 1
+    timed = rfem.refine(rfem.load(case_path("kane_beam.toml")), None, ["mode:1"], accuracy=1e-4, max_time=1e-6)
+    assert not timed["met"] and list(timed["ns"]) == [8] and "past --max-time" in timed["time_limit"]
+    m = rfem.modes(case_path("kane_beam.toml"), count=1, accuracy=1e-4, max_time=1e-6)
+    assert not m.accuracy.met and "past --max-time" in m.accuracy.shortfall[0]
+    for bad in (0, -1.0, float("nan")):
+        with pytest.raises(ValueError):
+            rfem.modes(case_path("kane_beam.toml"), accuracy=1e-4, max_time=bad)
 
 
 def test_accuracy_on_modes_static_and_run(tmp_path):
