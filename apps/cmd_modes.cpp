@@ -21,9 +21,9 @@ int run_modes(const Common& c, const ModesOptions& o) {
   const AccuracySpec target = accuracy_target(cs, c);
   std::optional<AccuracyResult> acc;
   if (target.given()) {
-    if (!o.free.empty()) throw CaseError("--accuracy: modes with --free joints are not refined yet; give --n");
     RefineRequest base;
     base.rate = o.rate;
+    base.free = o.free;
     base.threads = c.threads;
     base.warn = print_warning;
     base.on_n = ladder_lines(target, c.json || c.quiet);

@@ -70,7 +70,8 @@ void bind_accuracy(py::module_& m) {
                         args::Typed<"Optional[List[str]]"> accuracy, args::Typed<"Optional[int]"> max_n,
                         args::Typed<"Optional[float]"> max_time, args::Typed<"Optional[int]"> n_arg,
                         args::Typed<"int"> count, args::Typed<"Optional[float]"> rate, args::Typed<"int"> joint,
-                        args::Typed<"int"> threads, args::Typed<"Optional[Callable[[dict], Any]]"> progress) {
+                        args::Typed<"int"> threads, args::Typed<"Optional[Callable[[dict], Any]]"> progress,
+                        args::Typed<"Optional[List[Union[str, int]]]"> free) {
     const args::CaseArg cs_arg(case_arg);
     const Case& cs = *cs_arg;
     const std::string command = py::str(command_arg);
@@ -81,6 +82,7 @@ void bind_accuracy(py::module_& m) {
     Reported reported;
     RefineRequest base;
     base.rate = args::joint_rate(rate, joint);
+    base.free = args::free_joints(free);
     if (command == "run") reported = reported_by_run(cs);
     else if (command == "modes") reported = reported_by_modes(args::positive(count, "count"));
     else if (command == "static") reported = reported_by_static(cs, base.rate);
@@ -103,7 +105,7 @@ void bind_accuracy(py::module_& m) {
     py::object error = pending->take();  // (Ctrl-C: rfem._raise turns it into RunInterrupted)
     return py::make_tuple(py::cast(a), error);
   }, py::arg("case"), py::arg("command"), py::arg("accuracy"), py::arg("max_n"), py::arg("max_time"), py::arg("n"), py::arg("count"), py::arg("rate"),
-     py::arg("joint"), py::arg("threads"), py::arg("progress"));
+     py::arg("joint"), py::arg("threads"), py::arg("progress"), py::arg("free") = py::none());
 
   m.def("_write_accuracy", [](args::Typed<"Union[str, os.PathLike]"> path, const AccuracyResult& a) {
     const std::string p = args::path(path, "output");

@@ -221,6 +221,26 @@ class CaseArg {
   const Case* case_ = nullptr;
 };
 
+// `free` of rfem.modes: joint names or numbers from 1 (as --free), one or a list.
+inline std::vector<std::string> free_joints(py::handle v) {
+  std::vector<std::string> out;
+  auto one = [&](py::handle x, const std::string& name) {
+    if (PyUnicode_Check(x.ptr()) || PyBool_Check(x.ptr()) || !PyIndex_Check(x.ptr())) {
+      if (!PyUnicode_Check(x.ptr())) type_error(name, "a joint's name or number from 1", x);
+      out.push_back(text(x, name));
+    } else {
+      out.push_back(std::to_string(positive(x, name)));
+    }
+  };
+  if (v.is_none()) return out;
+  if (PyUnicode_Check(v.ptr()) || !py::isinstance<py::iterable>(v)) {
+    one(v, "free");
+    return out;
+  }
+  for (py::handle x : py::reinterpret_borrow<py::iterable>(v)) one(x, "free[" + std::to_string(out.size()) + "]");
+  return out;
+}
+
 /// A steady joint rate (rfem.static, rfem.modes, rfem.refine: rate=, joint=).
 inline JointRate joint_rate(py::handle rate, py::handle joint) {
   const std::optional<double> x = optional_real(rate, "rate", "a finite rate [rad/s or m/s] or None");

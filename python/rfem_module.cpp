@@ -94,25 +94,6 @@ std::vector<RunName> run_names(const std::vector<std::string>& names) {
 }
 
 
-// `free` of rfem.modes: joint names or numbers from 1 (as --free), one or a list.
-std::vector<std::string> free_joints(py::handle v) {
-  std::vector<std::string> out;
-  auto one = [&](py::handle x, const std::string& name) {
-    if (PyUnicode_Check(x.ptr()) || PyBool_Check(x.ptr()) || !PyIndex_Check(x.ptr())) {
-      if (!PyUnicode_Check(x.ptr())) args::type_error(name, "a joint's name or number from 1", x);
-      out.push_back(args::text(x, name));
-    } else {
-      out.push_back(std::to_string(args::positive(x, name)));
-    }
-  };
-  if (v.is_none()) return out;
-  if (PyUnicode_Check(v.ptr()) || !py::isinstance<py::iterable>(v)) {
-    one(v, "free");
-    return out;
-  }
-  for (py::handle x : py::reinterpret_borrow<py::iterable>(v)) one(x, "free[" + std::to_string(out.size()) + "]");
-  return out;
-}
 
 // A run request from Python: progress and Ctrl-C through `pending`, warnings collected.
 RunRequest python_request(const std::shared_ptr<CallGuard>& pending, py::handle progress, py::handle threads, py::handle keep_series,
@@ -458,7 +439,7 @@ PYBIND11_MODULE(_rfem, m) {
     ModesRequest rq;
     rq.n = args::rfes(n);
     rq.count = args::positive(count, "count");
-    rq.free = free_joints(free);
+    rq.free = args::free_joints(free);
     rq.rate = args::joint_rate(rate, joint);
     const std::string output = args::path(output_arg, "output", true);
     const std::string made_by = output.empty() ? "" : python_made_by("rfem.modes");

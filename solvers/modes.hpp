@@ -29,6 +29,8 @@ struct ModesResult {
 };
 
 constexpr double kUncertaintyTolerance = 1e-8;
+/// Problems up to this size (6n + free joints) are solved densely, larger ones by Lanczos.
+constexpr int kDenseModesLimit = 600;
 
 /// Lowest `count` modes. `vb` are the steady joint rates (empty or zero: no rotation).
 /// `free`: joints (0-based) that move with the modes instead of being held; each must carry no
@@ -36,7 +38,8 @@ constexpr double kUncertaintyTolerance = 1e-8;
 /// `dense_limit`: largest 6n + f solved densely. `parallel`: the threads of its kernels (statics,
 /// assembly, a reduced link's modes). Throws std::invalid_argument for bad arguments.
 ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, int count,
-                          int dense_limit = 600, const std::vector<int>& free = {}, const Parallelism& parallel = {});
+                          int dense_limit = kDenseModesLimit, const std::vector<int>& free = {},
+                          const Parallelism& parallel = {});
 
 /// Coordinates of an rfe a reduced link's modes span: x2, x3, φ1, φ2, φ3 (its axial x1 stays an
 /// unknown of its own: solvers/reduction.hpp says why).

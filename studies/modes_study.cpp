@@ -22,6 +22,9 @@ bool has_exact_reference(const Case& cs, const Model& model, const VecX& vb, boo
          l.segments[0].section.offset.norm() == 0.0;
 }
 
+
+}  // namespace
+
 // --free entries: joint numbers from 1, joint names, or "base" (the six of a free base).
 std::vector<int> free_joints(const Case& cs, const Model& model, const std::vector<std::string>& names) {
   std::vector<int> out;
@@ -45,8 +48,6 @@ std::vector<int> free_joints(const Case& cs, const Model& model, const std::vect
   return out;
 }
 
-}  // namespace
-
 ModesStudy modes_study(const Case& cs, const ModesRequest& rq) {
   ModesStudy s;
   s.model = model_of(cs, rq.n);
@@ -61,7 +62,7 @@ ModesStudy modes_study(const Case& cs, const ModesRequest& rq) {
   s.requested = rq.count;
   s.count = std::min(rq.count, all);
   try {
-    s.modes = compute_modes(model, qb, s.rates, s.count, 600, s.free);
+    s.modes = compute_modes(model, qb, s.rates, s.count, kDenseModesLimit, s.free);
   } catch (const std::invalid_argument& e) {
     throw CaseError(cs.path + ": --free: " + e.what());
   }

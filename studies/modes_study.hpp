@@ -45,6 +45,8 @@ struct ModesStudy {
 
 /// Throws CaseError for a case without a flexible link or a bad --free.
 ModesStudy modes_study(const Case& cs, const ModesRequest& request);
+/// ModesRequest::free resolved to 0-based joints of `model` (CaseError naming an unknown one).
+std::vector<int> free_joints(const Case& cs, const Model& model, const std::vector<std::string>& names);
 
 /// Writes the modes into a results file: group `modes` with `frequency` (Hz), `omega` (rad/s),
 /// `shapes` (a row per mode over the rfe coordinates and the free joints, columns named

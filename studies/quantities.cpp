@@ -12,6 +12,7 @@
 #include "../solvers/modes.hpp"
 #include "../solvers/statics.hpp"
 #include "linearize.hpp"
+#include "modes_study.hpp"
 
 namespace rfem {
 
@@ -204,7 +205,7 @@ Quantity parse_quantity(const Case& cs, const std::string& text) {
   return q;
 }
 
-double evaluate_quantity(const Case& cs, int n, const Quantity& s, const JointRate& rate) {
+double evaluate_quantity(const Case& cs, int n, const Quantity& s, const JointRate& rate, const std::vector<std::string>& free) {
   if (s.dynamic()) throw std::invalid_argument("evaluate_quantity: " + s.text + " needs a run (a refinement study)");
   const Model model = build_model(cs, n);
   VecX qb, vb;
@@ -224,21 +225,22 @@ double evaluate_quantity(const Case& cs, int n, const Quantity& s, const JointRa
                       std::to_string(modes.size()) + " oscillating modes");
     return modes[static_cast<size_t>(k - 1)].first;
   }
+  const std::vector<int> freed = free_joints(cs, model, free);
+  const int all = model.flexible_dofs() + static_cast<int>(freed.size());
   if (s.kind == Quantity::Kind::Mode) {
-    if (k > model.flexible_dofs())
-      throw CaseError("--quantity " + s.text + ": n = " + std::to_string(n) + " has only " + std::to_string(model.flexible_dofs()) + " modes");
-    return compute_modes(model, qb, vb, k).omega[k - 1] / (2 * M_PI);
+    if (k > all) throw CaseError("--quantity " + s.text + ": n = " + std::to_string(n) + " has only " + std::to_string(all) + " modes");
+    return compute_modes(model, qb, vb, k, kDenseModesLimit, freed).omega[k - 1] / (2 * M_PI);
   }
   // Modes of one kind can sit high in the spectrum (axial modes of a slender beam): widen the
   // search until the k-th one appears.
-  for (int count = std::min(model.flexible_dofs(), 4 * k + 8);; count = std::min(model.flexible_dofs(), 2 * count)) {
-    const ModesResult r = compute_modes(model, qb, vb, count);
+  for (int count = std::min(all, 4 * k + 8);; count = std::min(all, 2 * count)) {
+    const ModesResult r = compute_modes(model, qb, vb, count, kDenseModesLimit, freed);
     int seen = 0;
     for (int i = 0; i < count; ++i)
       if (to_string(r.kind[i]) == s.mode_kind && ++seen == k) return r.omega[i] / (2 * M_PI);
-    if (count == model.flexible_dofs()) break;
+    if (count == all) break;
   }
-  throw std::runtime_error("--quantity " + s.text + ": no such mode among all " + std::to_string(model.flexible_dofs()) +
+  throw std::runtime_error("--quantity " + s.text + ": no such mode among all " + std::to_string(all) +
                            " at n = " + std::to_string(n));
 }
 

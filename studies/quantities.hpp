@@ -62,7 +62,9 @@ struct Quantity {
 /// run, an unknown run, link or joint): CaseError with a one-line message.
 Quantity parse_quantity(const Case& cs, const std::string& text);
 /// A static or modal quantity at n rfes.
-double evaluate_quantity(const Case& cs, int n, const Quantity& q, const JointRate& rate = {});
+/// `free`: joints that move with a modal quantity's modes (`rfem modes --free`: numbers from 1, names, "base").
+double evaluate_quantity(const Case& cs, int n, const Quantity& q, const JointRate& rate = {},
+                         const std::vector<std::string>& free = {});
 /// The same from its text.
 double evaluate_quantity(const Case& cs, int n, const std::string& text, const JointRate& rate = {});
 /// A term's value in one output sample of its run.

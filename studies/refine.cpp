@@ -54,7 +54,7 @@ bool evaluate_point(const Case& c, int n, const std::vector<JointInput>& inputs,
     return false;
   }
   for (size_t k = 0; k < qs.size(); ++k) {
-    values[k].push_back(qs[k].dynamic() ? dyn[k] : evaluate_quantity(c, n, qs[k], rq.rate));
+    values[k].push_back(qs[k].dynamic() ? dyn[k] : evaluate_quantity(c, n, qs[k], rq.rate, rq.free));
     if (!std::isfinite(values[k].back()))
       throw std::runtime_error(label + ": " + qs[k].text + " is not finite: check the case's values");
   }

@@ -44,6 +44,7 @@ struct RefineRequest {
   /// for static and modal ones).
   double max_time = 0.0;
   JointRate rate;                       ///< for static and modal quantities
+  std::vector<std::string> free;        ///< joints that move with modal quantities' modes (`rfem modes --free`)
   int threads = 0;
   StopToken stop;                       ///< ends the study after the current run; rows done are kept
   /// Before each n (index from 0, count, n; index = count for the integration check; count 0 in a

@@ -151,10 +151,11 @@ def _accuracy_texts(accuracy):
                     f"not {type(accuracy).__name__}")
 
 
-def _target(case, command, accuracy, max_n, n, count=6, rate=None, joint=1, threads=0, progress=None, max_time=None):
+def _target(case, command, accuracy, max_n, n, count=6, rate=None, joint=1, threads=0, progress=None, max_time=None,
+            free=None):
     """The Accuracy a target asks for (accuracy=, or the case's [accuracy] without n), or None."""
     acc, error = _rfem._accuracy(case, command, _accuracy_texts(accuracy), max_n, max_time, n, count, rate, joint, threads,
-                                 progress)
+                                 progress, free)
     _raise(error, acc)
     return acc
 
@@ -307,9 +308,7 @@ def modes(case, n=None, count=6, free=(), rate=None, joint=1, output=None, accur
     shapes, exact references for one uniform segment); `output`: an HDF5 file with the
     frequencies and shapes (group modes, as `rfem modes -o`). accuracy= (as rfem.run's; `rfem
     modes --accuracy`): n chosen for the first `count` frequencies; .accuracy has their bars."""
-    acc = _target(case, "modes", accuracy, max_n, n, count=count, rate=rate, joint=joint, max_time=max_time)
-    if acc is not None and free:
-        raise CaseError("--accuracy: modes with --free joints are not refined yet; give --n")
+    acc = _target(case, "modes", accuracy, max_n, n, count=count, rate=rate, joint=joint, max_time=max_time, free=free)
     result = _rfem._modes(case, acc.n if acc is not None else n, count, free, rate, joint, output)
     result.accuracy = acc
     if acc is not None and output is not None:

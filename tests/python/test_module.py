@@ -132,6 +132,12 @@ def test_accuracy_on_modes_static_and_run(tmp_path):
         assert code == 2 and err.strip() == "rfem: error: " + str(e.value)
     with pytest.raises(rfem.CaseError):
         rfem.modes(beam, n=16, accuracy=1e-3)
+    code, out, err = program("modes", case_path("kane_spinup.toml"), "--free", "hub", "--count", "4", "--accuracy", "1e-4",
+                             "--json")
+    js = json.loads(out)["accuracy"]
+    free = rfem.modes(case_path("kane_spinup.toml"), count=4, free=["hub"], accuracy=1e-4)
+    assert code == 0 and free.accuracy.met and free.n == js["n"] and free.accuracy["mode:1"]["zero"]
+    assert free.accuracy["mode:3"]["value"] == js["estimates"][2]["value"] == pytest.approx(2.650079, abs=1e-6)
     lin = rfem.linearize(case_path("two_link_arm.toml"), accuracy=1e-3)
     assert lin.accuracy.met and len(lin.accuracy) == 6 and lin.accuracy["linear:1"]["value"] == pytest.approx(
         lin.modes(1)[0][0], rel=1e-9)
