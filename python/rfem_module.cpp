@@ -93,8 +93,6 @@ std::vector<RunName> run_names(const std::vector<std::string>& names) {
   return out;
 }
 
-
-
 // A run request from Python: progress and Ctrl-C through `pending`, warnings collected.
 RunRequest python_request(const std::shared_ptr<CallGuard>& pending, py::handle progress, py::handle threads, py::handle keep_series,
                           py::handle checkpoint, std::vector<std::string>& warnings) {

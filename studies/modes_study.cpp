@@ -22,7 +22,6 @@ bool has_exact_reference(const Case& cs, const Model& model, const VecX& vb, boo
          l.segments[0].section.offset.norm() == 0.0;
 }
 
-
 }  // namespace
 
 // --free entries: joint numbers from 1, joint names, or "base" (the six of a free base).
