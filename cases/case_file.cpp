@@ -328,7 +328,7 @@ Model build_model(const Case& c, int n) {
     if (ml.d.modes > kModalAxes * ml.d.n())
       throw CaseError(c.path + (c.links[l].modes_line > 0 ? ":" + std::to_string(c.links[l].modes_line) : std::string(" (--set or missing)")) + ": " +
                       c.links[l].key + ".modes: " + std::to_string(ml.d.modes) + " modes, but n = " + std::to_string(ml.d.n()) +
-                      " rfes have only " + std::to_string(kModalAxes * ml.d.n()) + " to keep (5 per rfe: the axial ones stay)");
+                      " rfes have only " + std::to_string(kModalAxes * ml.d.n()) + " to keep (3 per rfe, the rotations: the displacements stay unknowns)");
     ml.d.derivatives = c.links[l].derivatives;
     if (ml.d.derivatives > ml.d.modes)
       throw CaseError(c.path + (c.links[l].derivatives_line > 0 ? ":" + std::to_string(c.links[l].derivatives_line) : std::string(" (--set or missing)")) +

@@ -3,27 +3,24 @@
 
 The paper's procedure (cases/paper_deployment.toml, n = 60 rfes on link 3; rigid, kinematic and
 force runs) with link 3 kept whole and reduced to its first m = 4, 8, 16 clamped modes
-(`--set link.modes=8`; README "Reduced links", docs/formulation.md §9). Each rfe keeps its axial
-coordinate; the other five coordinates of the 60 rfes (300) become the m modal amplitudes. Printed:
-1. the unknowns, steps and residual evaluations of each run (what the reduction buys: the force
-   run follows the undamped modes the full model carries; the reduced one only the m it keeps and
-   the coupled joint-link modes they make),
-2. the peaks |u1|, |u2|, |θ| of the tip and their distance from the full model's (u1 and u2 converge
-   as m grows to ~1e-4 and ~1e-3; θ does not: segment B1's torsion constant as the paper prints it,
-   J = 2.2e-11 m⁴, leaves its rfes nearly free to twist, and the twist the full model shows comes from
-   second-order kinematics that a basis of linear modes in rfe coordinates does not carry — README);
-   with the static derivatives of the first 6 modes (`link.derivatives = 6`, docs/formulation.md §9:
-   19 second-order shapes more) all three come within 1e-4,
+(`--set link.modes=8`; README "Reduced links", docs/formulation.md §9). Each rfe keeps its three
+displacements; the three rotations of the 60 rfes (180) become the m modal amplitudes. Printed:
+1. the unknowns, steps and residual evaluations of each run (the reduction does not buy steps on
+   this link: the displacements keep the full model's stiff axial and shear frequencies),
+2. the peaks |u1|, |u2|, |θ| of the tip and their distance from the full model's: all three
+   converge as m grows (m = 8 within 1.3e-3, m = 16 within 8.6e-5). Segment B1 is nearly free to
+   twist (J = 2.2e-11 m⁴ as the paper prints it) and part of its twist is second order in the
+   bending: the static derivatives of the first 6 modes (`link.derivatives = 6`, docs/formulation.md
+   §9: 18 second-order shapes more) bring θ within 6.3e-5 with 8 modes,
 3. the force run's tip u1 at a few times, full against m = 8 with and without the derivatives, and
    the energy balance (the work of the joint torques against T + V: the Galerkin projection
    conserves what the full model does).
 Steps and wall times vary with the machine and the build: they are on lines starting with "#".
-Measured on the project's two-core machine (one thread), at the default tolerances: force run
-5 677 steps, 1.1 s (full); 2 251, 0.5 s (m = 4); 3 755, 0.9 s (m = 8); 4 974, 1.3 s (m = 16); 4 160,
-1.4 s (m = 8 with the derivatives) — at n = 60 a reduced step costs about what a full one does (the
-full residual is still evaluated, and the projection is added), and the coupled modes of the kept
-shapes reach tens of Hz. bench/reduction_bench.py measures n = 1 000, where at atol 1e-8 the force
-run with the derivatives takes 1.32–1.44× the full kinematic run (README, "Reduced links").
+Measured on the project's two-core machine (one thread, a slow hour), at the default tolerances:
+force run 5 677 steps, 2.8 s (full); 2 499, 1.2 s (m = 4); 4 456, 2.4 s (m = 8); 6 584, 3.3 s
+(m = 16); 5 492, 3.3 s (m = 8 with the derivatives). bench/reduction_bench.py measures n = 1 000,
+where the reduced force run costs 1.17–1.23× the full one at the same tolerances (README, "Reduced
+links").
 
     PYTHONPATH=build/python /usr/bin/python3 examples/ex15_reduced_force.py        (~8 s)
 """
@@ -38,7 +35,7 @@ path = os.path.join(here, "..", "cases", "paper_deployment.toml")
 N = 60
 
 CONFIGS = ((0, 0), (4, 0), (8, 0), (16, 0), (8, 6))  # (modes, derivatives)
-DERIVED = 19  # of the 21 derivatives of modes 1 … 6, those that add a shape (docs/formulation.md §9)
+DERIVED = 18  # of the 21 derivatives of modes 1 … 6, those that add a rotation (docs/formulation.md §9)
 
 
 def label(c):
@@ -51,7 +48,7 @@ for c in CONFIGS:
     m, p = c
     case = rfem.load(path, {"link.modes": m, "link.derivatives": p})
     results[c] = rfem.run(case, n=N, threads=1)
-    unknowns = 6 * N if m == 0 else N + m + (DERIVED if p else 0)
+    unknowns = 6 * N if m == 0 else 3 * N + m + (DERIVED if p else 0)  # (rfem show --json says the same)
     name = label(c)
     print(f"{name}: link 3 has {unknowns} unknowns; the kinematic and force runs (steps differ between CPUs' builds):")
     for r in ("kinematic", "force"):

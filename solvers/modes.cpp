@@ -233,7 +233,7 @@ namespace {
 // sub-model: K θ_ij = −∂²f/∂η_i∂η_j, f the static forces (sdes, gravity) about the equilibrium
 // all.q0 and K = ∂f/∂q there. The second derivative by central differences along φ_i ± φ_j with the
 // largest coordinate moved by 1e-3 (m or rad): truncation O(h²), ~1e-6 of the derivative; round-off
-// ε|f|/h² far below that. Appended to `out` over the lateral axes like the modes (x1 rows out).
+// ε|f|/h² far below that. Appended to `out` over the rotation axes like the modes (displacement rows out).
 void add_modal_derivatives(const Model& sub, int l, const std::shared_ptr<const BorderedPattern>& pattern,
                            const std::vector<double>& Mv, const ModesResult& all, const std::vector<int>& pick, int p,
                            const Parallelism& parallel, LinkModes& out) {
@@ -260,9 +260,9 @@ void add_modal_derivatives(const Model& sub, int l, const std::shared_ptr<const 
     generalised_forces(sub, q, z, z, ft, f, nullptr, &ws);
     return VecX(f.head(nf));
   };
-  auto lateral = [&](const VecX& x) {
+  auto rotations = [&](const VecX& x) {
     VecX y(N);
-    for (int k = 0; k < n; ++k) y.segment<kModalAxes>(kModalAxes * k) = x.segment<kModalAxes>(sub.rfe_index(l, k) + 1);
+    for (int k = 0; k < n; ++k) y.segment<kModalAxes>(kModalAxes * k) = x.segment<kModalAxes>(sub.rfe_index(l, k) + kModalFirst);
     return y;
   };
   // An orthonormal basis of the columns so far: a derivative they (nearly) span adds nothing.
@@ -273,23 +273,23 @@ void add_modal_derivatives(const Model& sub, int l, const std::shared_ptr<const 
       const double h = 1e-3 / std::max(a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff());
       VecX theta = -(forces(h * (a + b)) - forces(h * (a - b)) - forces(h * (b - a)) + forces(-h * (a + b))) / (4 * h * h);
       solver->solve(theta);
-      const VecX lat = lateral(theta);
-      VecX r = lat;
+      const VecX rot = rotations(theta);
+      VecX r = rot;
       for (int pass = 0; pass < 2; ++pass) r -= Q * (Q.transpose() * r);  // (twice: classical Gram–Schmidt)
-      if (!(r.norm() > 1e-6 * lat.norm())) continue;
+      if (!(r.norm() > kNewDirection * rot.norm())) continue;
       r /= r.norm();
       Q.conservativeResize(N, Q.cols() + 1);
       Q.col(Q.cols() - 1) = r;
       // The column: its new direction, scaled to a largest coordinate of 1; M_bb of it.
       VecX full = VecX::Zero(nf), Mr;
-      for (int k = 0; k < n; ++k) full.segment<kModalAxes>(sub.rfe_index(l, k) + 1) = r.segment<kModalAxes>(kModalAxes * k);
+      for (int k = 0; k < n; ++k) full.segment<kModalAxes>(sub.rfe_index(l, k) + kModalFirst) = r.segment<kModalAxes>(kModalAxes * k);
       const double s = 1.0 / r.cwiseAbs().maxCoeff();
       pattern->multiply(Mv, full, Mr);
       const int c = static_cast<int>(out.shapes.cols());
       out.shapes.conservativeResize(N, c + 1);
       out.mass_shapes.conservativeResize(N, c + 1);
       out.shapes.col(c) = s * r;
-      out.mass_shapes.col(c) = s * lateral(Mr);
+      out.mass_shapes.col(c) = s * rotations(Mr);
       out.pairs.emplace_back(i + 1, j + 1);
     }
 }
@@ -301,8 +301,8 @@ LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int d
   const MountedLink& L = model.links[l];
   const int n = L.n(), N = kModalAxes * n;
   if (count < 1 || count > N)
-    throw std::invalid_argument("link " + L.name + ": modes = " + std::to_string(count) + " must be between 1 and its 5n = " +
-                                std::to_string(N) + " coordinates other than the axial ones");
+    throw std::invalid_argument("link " + L.name + ": modes = " + std::to_string(count) + " must be between 1 and its 3n = " +
+                                std::to_string(N) + " rotations");
   if (derivatives < 0 || derivatives > std::min(count, kMaxDerivativeModes))
     throw std::invalid_argument("link " + L.name + ": derivatives = " + std::to_string(derivatives) + " must be between 0 and " +
                                 std::to_string(std::min(count, kMaxDerivativeModes)) + " (the modes kept, at most " +
@@ -318,22 +318,35 @@ LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int d
     links.push_back(std::move(r));
   }
   const Model sub = make_model(model.joints, std::move(links), model.gravity, model.free_base);
-  // The first count modes that are not axial (the axial coordinates are unknowns of their own, and
-  // an axial mode without its x1 rows is next to nothing), and one more: a cut through equal
-  // frequencies is refused.
+  // The first count modes whose rotation rows add a direction to those before them (an axial mode
+  // has none; above the bending modes, the shear modes' rotations repeat theirs), and one more: a cut
+  // through equal frequencies is refused. At count = 3n the rotations are complete.
   const int N6 = Model::rfe_dofs * n;
   ModesResult all;
   std::vector<int> pick;
   for (int want = std::min(N6, 2 * count + 8);; want = std::min(N6, 2 * want)) {
     all = modes_of(sub, qb, VecX(), want, 2 * want > N6 ? N6 : 600, {}, parallel);
     pick.clear();
-    for (int i = 0; i < want && static_cast<int>(pick.size()) <= count; ++i)
-      if (all.kind[i] != ModeKind::Axial) pick.push_back(i);
+    MatX Q(N, 0);  // an orthonormal basis of the picked modes' rotation rows
+    for (int i = 0; i < want && static_cast<int>(pick.size()) <= count; ++i) {
+      VecX r(N);
+      double norm = 0.0;  // of the mode over all its link's coordinates: an axial mode's rotations are round-off of it
+      for (int k = 0; k < n; ++k) {
+        r.segment<kModalAxes>(kModalAxes * k) = all.shapes.col(i).segment<kModalAxes>(sub.rfe_index(l, k) + kModalFirst);
+        norm += all.shapes.col(i).segment<Model::rfe_dofs>(sub.rfe_index(l, k)).squaredNorm();
+      }
+      norm = std::sqrt(norm);
+      for (int pass = 0; pass < 2; ++pass) r -= Q * (Q.transpose() * r);  // (twice: classical Gram–Schmidt)
+      if (!(r.norm() > kNewDirection * norm)) continue;
+      pick.push_back(i);
+      Q.conservativeResize(N, Q.cols() + 1);
+      Q.col(Q.cols() - 1) = r / r.norm();
+    }
     if (static_cast<int>(pick.size()) > count || want == N6) break;
   }
   if (static_cast<int>(pick.size()) < count)
     throw std::invalid_argument("link " + L.name + ": modes = " + std::to_string(count) + ": it has only " +
-                                std::to_string(pick.size()) + " modes that are not axial");
+                                std::to_string(pick.size()) + " modes whose rotations are independent");
   if (static_cast<int>(pick.size()) > count &&
       std::abs(all.omega[pick[count]] - all.omega[pick[count - 1]]) <= 1e-6 * all.omega[pick[count]])
     throw std::invalid_argument("link " + L.name + ": modes = " + std::to_string(count) + " keeps one of two equal frequencies (" +
@@ -347,8 +360,8 @@ LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int d
   std::vector<double> Mv;
   Workspace ws(sub, parallel);
   assemble_matrix(sub, pattern, held, all.q0, VecX::Zero(sub.dof()), mt, Mv, &ws);
-  // The shapes over the coordinates a reduced link's modes span (its x1 stay unknowns of their own)
-  // and M_bb Φ_b over them: the x1 rows of M Φ left out, which is M_bb Φ_b + M_b1 Φ_1.
+  // The shapes over the coordinates a reduced link's modes span (its displacements stay unknowns of
+  // their own) and M_bb Φ_b over them: Φ's displacement rows zeroed first, so M_bb Φ_b alone.
   LinkModes out;
   out.omega.resize(count);
   out.shapes.resize(N, count);
@@ -356,12 +369,12 @@ LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int d
   for (int c = 0; c < count; ++c) {
     out.omega[c] = all.omega[pick[c]];
     VecX phi = all.shapes.col(pick[c]), Mphi;
-    for (int k = 0; k < n; ++k) phi[sub.rfe_index(l, k)] = 0.0;  // x1 rows out: M_bb Φ_b below
+    for (int k = 0; k < n; ++k) phi.segment<kModalFirst>(sub.rfe_index(l, k)).setZero();  // kept rows out: M_bb Φ_b below
     pattern.multiply(Mv, phi, Mphi);
     for (int k = 0; k < n; ++k) {
       const int at = sub.rfe_index(l, k);
-      out.shapes.col(c).segment<kModalAxes>(kModalAxes * k) = phi.segment<kModalAxes>(at + 1);
-      out.mass_shapes.col(c).segment<kModalAxes>(kModalAxes * k) = Mphi.segment<kModalAxes>(at + 1);
+      out.shapes.col(c).segment<kModalAxes>(kModalAxes * k) = phi.segment<kModalAxes>(at + kModalFirst);
+      out.mass_shapes.col(c).segment<kModalAxes>(kModalAxes * k) = Mphi.segment<kModalAxes>(at + kModalFirst);
     }
   }
   if (derivatives > 0) add_modal_derivatives(sub, l, shared_pattern, Mv, all, pick, derivatives, parallel, out);

@@ -41,9 +41,14 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
                           int dense_limit = kDenseModesLimit, const std::vector<int>& free = {},
                           const Parallelism& parallel = {});
 
-/// Coordinates of an rfe a reduced link's modes span: x2, x3, φ1, φ2, φ3 (its axial x1 stays an
-/// unknown of its own: solvers/reduction.hpp says why).
-constexpr int kModalAxes = 5;
+/// Coordinates of an rfe a reduced link's modes span: its rotations φ1, φ2, φ3, the last three of
+/// its six (its displacements x1, x2, x3 stay unknowns of their own: solvers/reduction.hpp says why).
+constexpr int kModalAxes = 3;
+/// The first of them within an rfe's six coordinates.
+constexpr int kModalFirst = 6 - kModalAxes;
+/// A column joins a reduced link's basis when, orthogonalised against those before it, more than
+/// this fraction of its norm is left (less is round-off of a direction already held).
+constexpr double kNewDirection = 1e-6;
 
 /// The most modes whose pairwise static derivatives a reduced link may add (p(p + 1)/2 vectors).
 constexpr int kMaxDerivativeModes = 16;
@@ -54,11 +59,11 @@ constexpr int kMaxDerivativeModes = 16;
 /// `derivatives` = p > 0, the static modal derivatives of modes i ≤ j ≤ p follow them
 /// (docs/formulation.md §9): K θ_ij = −∂²f/∂η_i∂η_j, the second-order shapes a linear basis lacks,
 /// each orthogonalised against the columns before it and left out where it adds nothing (≤ 1e-6 of
-/// its norm). Throws std::invalid_argument for count outside 1 … 5n, a count that cuts a pair of
+/// its norm). Throws std::invalid_argument for count outside 1 … 3n, a count that cuts a pair of
 /// equal frequencies, or derivatives outside 0 … min(count, kMaxDerivativeModes).
 struct LinkModes {
   VecX omega;        ///< the modes' [rad/s], ascending (count values: the derivatives have none)
-  MatX shapes;       ///< 5n × (count + derivatives) over kModalAxes axes per rfe, rfe by rfe (x1 rows left out)
+  MatX shapes;       ///< 3n × (count + derivatives) over kModalAxes axes per rfe, rfe by rfe (displacement rows left out)
   MatX mass_shapes;  ///< M_bb shapes (M_bb the link's mass matrix over those coordinates)
   VecX q0;           ///< the equilibrium, 6n, rfe by rfe
   std::vector<std::pair<int, int>> pairs;  ///< (i, j), from 1, of each derivative column after the modes

@@ -18,7 +18,7 @@ Reduction::Reduction(const Model& model, const VecX& qb, const Parallelism& para
     r.link = static_cast<int>(l);
     for (int k = 0; k < L.n(); ++k) {
       r.rfe.push_back(model.rfe_index(static_cast<int>(l), k));
-      for (int a = 1; a < Model::rfe_dofs; ++a) reduced[r.rfe.back() + a] = 1;  // x1 stays an unknown
+      for (int a = kModalFirst; a < Model::rfe_dofs; ++a) reduced[r.rfe.back() + a] = 1;  // x1, x2, x3 stay unknowns
     }
     r.phi = std::move(lm.shapes);
     r.phi_rows = r.phi;
@@ -26,7 +26,7 @@ Reduction::Reduction(const Model& model, const VecX& qb, const Parallelism& para
     r.gram.compute(r.phi.transpose() * r.mass_phi);
     if (r.gram.info() != Eigen::Success)
       throw std::invalid_argument("link " + L.name + ": its " + std::to_string(L.d.modes) +
-                                  " modes are not independent without their axial rows: keep fewer");
+                                  " modes are not independent in their rotations: keep fewer");
     r.q0 = std::move(lm.q0);
     r.omega = std::move(lm.omega);
     r.modes = L.d.modes;
@@ -55,7 +55,7 @@ SparseMat Reduction::projector(int k) const {
   for (const Link& r : links_)
     for (size_t e = 0; e < r.rfe.size(); ++e)
       for (int a = 0; a < kModalAxes; ++a)
-        for (int c = 0; c < r.phi.cols(); ++c) t.emplace_back(r.rfe[e] + 1 + a, r.first + c, r.phi(kModalAxes * e + a, c));
+        for (int c = 0; c < r.phi.cols(); ++c) t.emplace_back(r.rfe[e] + kModalFirst + a, r.first + c, r.phi(kModalAxes * e + a, c));
   for (int j = 0; j < k; ++j) t.emplace_back(full_rfe_ + j, rfe_ + j, 1.0);
   SparseMat P(full_rfe_ + k, rfe_ + k);
   P.setFromTriplets(t.begin(), t.end());
@@ -84,10 +84,10 @@ double* scratch(size_t n) {
 }  // namespace
 
 // The lifts' loop, in one parallel region: kept(i, full index) for each kept coordinate i; for each
-// reduced link's rows in the thread's part, Φ times the `cols` vectors x, then lateral(link, rfe e,
+// reduced link's rows in the thread's part, Φ times the `cols` vectors x, then modal(link, rfe e,
 // axis, full index, d) with vector c's product at d[c · stride].
-template <class Kept, class Lateral>
-void Reduction::for_lifted(const double* const* x, int cols, int team, Kept&& kept, Lateral&& lateral) const {
+template <class Kept, class Modal>
+void Reduction::for_lifted(const double* const* x, int cols, int team, Kept&& kept, Modal&& modal) const {
   for_team_threads(team, [&](int t, int T) {
     const long nk = static_cast<long>(kept_.size());
     for (long i = team_part(nk, t, T); i < team_part(nk, t + 1, T); ++i) kept(i, kept_[i]);
@@ -98,7 +98,7 @@ void Reduction::for_lifted(const double* const* x, int cols, int team, Kept&& ke
       phi_times(r, b, end, x, cols, part);
       for (long e = b; e < end; ++e)
         for (int ax = 0; ax < kModalAxes; ++ax)
-          lateral(r, e, ax, r.rfe[e] + 1 + ax, part + kModalAxes * (e - b) + ax, rows);
+          modal(r, e, ax, r.rfe[e] + kModalFirst + ax, part + kModalAxes * (e - b) + ax, rows);
     }
   });
 }
@@ -106,7 +106,7 @@ void Reduction::for_lifted(const double* const* x, int cols, int team, Kept&& ke
 void Reduction::lift(const double* x, double* xf, int k, bool positions, int team) const {
   for_lifted(&x, 1, team, [&](long i, long at) { xf[at] = x[i]; },
              [&](const Link& r, long e, int ax, long at, const double* d, long) {
-               xf[at] = d[0] + (positions ? r.q0[6 * e + 1 + ax] : 0.0);
+               xf[at] = d[0] + (positions ? r.q0[6 * e + kModalFirst + ax] : 0.0);
              });
   for (int j = 0; j < k; ++j) xf[full_rfe_ + j] = x[rfe_ + j];
 }
@@ -122,7 +122,7 @@ void Reduction::lift_state(const double* q, const double* v, const double* a, do
         for (int c = 0; c < cols; ++c) xf[c][at] = x[c][i];
       },
       [&](const Link& r, long e, int ax, long at, const double* d, long stride) {
-        xf[0][at] = d[0] + r.q0[6 * e + 1 + ax];
+        xf[0][at] = d[0] + r.q0[6 * e + kModalFirst + ax];
         for (int c = 1; c < cols; ++c) xf[c][at] = d[c * stride];
       });
   for (int j = 0; j < k; ++j)
@@ -169,7 +169,7 @@ void Reduction::project(const double* rf, double* r, int k, int team) const {
       for (long b = blocks * t / T; b < blocks * (t + 1) / T; ++b) {
         const long e0 = b * kProjectBlock, len = std::min(n, e0 + kProjectBlock) - e0;
         for (long e = 0; e < len; ++e)
-          for (int a = 0; a < kModalAxes; ++a) lat[kModalAxes * e + a] = rf[l.rfe[e0 + e] + 1 + a];
+          for (int a = 0; a < kModalAxes; ++a) lat[kModalAxes * e + a] = rf[l.rfe[e0 + e] + kModalFirst + a];
         partial[li].col(b).noalias() = l.phi_rows.middleRows(kModalAxes * e0, kModalAxes * len).transpose() * lat.head(kModalAxes * len);
       }
     }
@@ -188,7 +188,7 @@ void Reduction::restrict(const double* xf, double* x, int k, bool positions) con
     VecX part(l.phi.rows());
     for (size_t e = 0; e < l.rfe.size(); ++e)
       for (int a = 0; a < kModalAxes; ++a)
-        part[kModalAxes * e + a] = xf[l.rfe[e] + 1 + a] - (positions ? l.q0[6 * e + 1 + a] : 0.0);
+        part[kModalAxes * e + a] = xf[l.rfe[e] + kModalFirst + a] - (positions ? l.q0[6 * e + kModalFirst + a] : 0.0);
     Eigen::Map<VecX>(x + l.first, l.phi.cols()) = l.gram.solve(l.mass_phi.transpose() * part);
   }
   for (int j = 0; j < k; ++j) x[rfe_ + j] = xf[full_rfe_ + j];
@@ -216,7 +216,7 @@ Projection::Projection(const Reduction& red, const BorderedPattern& pattern) : r
   for (long k = 0; k < S_.nonZeros(); ++k) slot_[static_cast<size_t>(k)] = static_cast<long>(S_.valuePtr()[k]);
 
   // Full coordinate → reduced: kept ones (rfe coordinates kept, joints) to their reduced index,
-  // a reduced link's lateral ones to (link, row of Φ_l).
+  // a reduced link's modal ones to (link, row of Φ_l).
   const int joints = n - red.full_rfe();
   const auto& links = red.links();
   const int L = static_cast<int>(links.size());
@@ -226,15 +226,15 @@ Projection::Projection(const Reduction& red, const BorderedPattern& pattern) : r
   for (int l = 0; l < L; ++l)
     for (size_t e = 0; e < links[l].rfe.size(); ++e)
       for (int ax = 0; ax < kModalAxes; ++ax) {
-        link_of_[links[l].rfe[e] + 1 + ax] = l;
-        phi_row_[links[l].rfe[e] + 1 + ax] = kModalAxes * static_cast<int>(e) + ax;
+        link_of_[links[l].rfe[e] + kModalFirst + ax] = l;
+        phi_row_[links[l].rfe[e] + kModalFirst + ax] = kModalAxes * static_cast<int>(e) + ax;
       }
   for (int i = 0, k = 0; i < red.full_rfe(); ++i)
     if (link_of_[i] < 0) to[i] = k++;
   for (int j = 0; j < joints; ++j) to[red.full_rfe() + j] = red.rfe() + j;
 
   // The reduced pattern: kept × kept where S has an entry; kept × η_l (dense) where the kept row
-  // touches link l's lateral rows; η_l × η_l' (dense) where the links' lateral rows touch.
+  // touches link l's modal rows; η_l × η_l' (dense) where the links' modal rows touch.
   const int nr = red.rfe() + joints;
   std::vector<char> pair(static_cast<size_t>(L * L), 0);
   std::vector<Eigen::Triplet<double>> rt;
@@ -271,32 +271,32 @@ Projection::Projection(const Reduction& red, const BorderedPattern& pattern) : r
   R_.setFromTriplets(rt.begin(), rt.end());  // (each entry once)
   source_.resize(static_cast<size_t>(R_.nonZeros()));
   for (long k = 0; k < R_.nonZeros(); ++k) source_[static_cast<size_t>(k)] = src[static_cast<size_t>(R_.valuePtr()[k])];
-  // W's rows: a kept coordinate's at its reduced index (to), link l's lateral ones after every
+  // W's rows: a kept coordinate's at its reduced index (to), link l's modal ones after every
   // reduced rfe unknown and joint (at nr), in Φ_l's row order.
   w_row_.assign(static_cast<size_t>(n), -1);
-  lateral_first_.assign(static_cast<size_t>(L), 0);
+  modal_first_.assign(static_cast<size_t>(L), 0);
   for (int i = 0; i < n; ++i)
     if (to[i] >= 0) w_row_[static_cast<size_t>(i)] = to[i];
   int w_rows = nr;
   for (int l = 0; l < L; w_rows += static_cast<int>(links[l].phi_rows.rows()), ++l) {
-    lateral_first_[static_cast<size_t>(l)] = w_rows;
+    modal_first_[static_cast<size_t>(l)] = w_rows;
     for (int i = 0; i < n; ++i)
       if (link_of_[i] == l) w_row_[static_cast<size_t>(i)] = w_rows + phi_row_[i];
   }
-  lat_ptr_.assign(static_cast<size_t>(n) + 1, 0);
+  modal_ptr_.assign(static_cast<size_t>(n) + 1, 0);
   for (int c = 0; c < n; ++c) {
     for (long k = S_.outerIndexPtr()[c]; k < S_.outerIndexPtr()[c + 1]; ++k) {
       const int j = S_.innerIndexPtr()[k];
-      if (link_of_[j] >= 0) lat_.push_back(Lateral{k, link_of_[j], phi_row_[j]});
+      if (link_of_[j] >= 0) lat_.push_back(Modal{k, link_of_[j], phi_row_[j]});
     }
-    lat_ptr_[static_cast<size_t>(c) + 1] = static_cast<long>(lat_.size());
+    modal_ptr_[static_cast<size_t>(c) + 1] = static_cast<long>(lat_.size());
   }
-  twin_.assign(static_cast<size_t>(n), 0);  // column c's lateral entries in the same links and rows of Φ as c + 1's
+  twin_.assign(static_cast<size_t>(n), 0);  // column c's modal entries in the same links and rows of Φ as c + 1's
   for (int c = 0; c + 1 < n; ++c) {
-    const long len = lat_ptr_[c + 1] - lat_ptr_[c];
-    bool same = len > 0 && lat_ptr_[c + 2] - lat_ptr_[c + 1] == len;
+    const long len = modal_ptr_[c + 1] - modal_ptr_[c];
+    bool same = len > 0 && modal_ptr_[c + 2] - modal_ptr_[c + 1] == len;
     for (long t = 0; same && t < len; ++t) {
-      const Lateral &a = lat_[static_cast<size_t>(lat_ptr_[c] + t)], &b = lat_[static_cast<size_t>(lat_ptr_[c + 1] + t)];
+      const Modal &a = lat_[static_cast<size_t>(modal_ptr_[c] + t)], &b = lat_[static_cast<size_t>(modal_ptr_[c + 1] + t)];
       same = a.link == b.link && a.phi_row == b.phi_row;
     }
     twin_[static_cast<size_t>(c)] = same;
@@ -308,21 +308,20 @@ Projection::Projection(const Reduction& red, const BorderedPattern& pattern) : r
 
 namespace {
 constexpr int kWBlock = 8;     // columns of W = S Φ summed in registers
-constexpr int kSweeps = 4;     // border columns of T⁻¹ B swept together
 constexpr int kGramBlock = 8;  // columns of Φ_lᵀ W_l' per product (fixed: each entry's sum is the same for any team)
 }
 
-// W rows i … i + R − 1 from their lateral entries lat_[lat_ptr_[i + r] + skip …] (count of them,
+// W rows i … i + R − 1 from their modal entries lat_[modal_ptr_[i + r] + skip …] (count of them,
 // one link's; the same rows of Φ for every r: twin_): the rows of Φ summed in S's order, eight
 // columns at a time in registers (adding each row of Φ to W's row in memory waited on the store:
 // 2× slower), each load of Φ serving the R rows.
 template <int R>
 void Projection::w_rows(long i, long skip, long count, const double* v) {
-  const Lateral* x[R];
+  const Modal* x[R];
   double* w[R];
-  const int l = lat_[static_cast<size_t>(lat_ptr_[i] + skip)].link;
+  const int l = lat_[static_cast<size_t>(modal_ptr_[i] + skip)].link;
   for (int r = 0; r < R; ++r) {
-    x[r] = lat_.data() + lat_ptr_[i + r] + skip;
+    x[r] = lat_.data() + modal_ptr_[i + r] + skip;
     w[r] = W_[static_cast<size_t>(l)].row(w_row_[i + r]).data();
   }
   const auto& phi_rows = red_->links()[static_cast<size_t>(l)].phi_rows;
@@ -364,31 +363,31 @@ const SparseMat& Projection::reduce(const std::vector<double>& values, int team)
   for_team_parts(static_cast<long>(slot_.size()), team, [&](long b, long e) {
     for (long k = b; k < e; ++k) v[k] = values[static_cast<size_t>(slot_[k])];
   });
-  // W_l = S Φ_l row by row: row i from S's column i (S is symmetric), its lateral entries (listed
+  // W_l = S Φ_l row by row: row i from S's column i (S is symmetric), its modal entries (listed
   // once: lat_), the rows of Φ_l summed in S's order.
-  // W's rows are the full coordinates reordered (w_row_): kept ones, then each link's lateral rows
+  // W's rows are the full coordinates reordered (w_row_): kept ones, then each link's modal rows
   // in Φ's order, so Φ_lᵀ W_l' reads W in place.
   for_team_parts(n, team, [&](long b, long e) {
     for (long i = b; i < e; ++i) {
       const int R = twin_[static_cast<size_t>(i)] && i + 1 < e ? 2 : 1;  // (the same sums either way)
       for (int r = 0; r < R; ++r)
         for (int l = 0; l < L; ++l) W_[static_cast<size_t>(l)].row(w_row_[i + r]).setZero();
-      for (long p = lat_ptr_[i], p1 = lat_ptr_[i + 1]; p < p1;) {
+      for (long p = modal_ptr_[i], p1 = modal_ptr_[i + 1]; p < p1;) {
         const int l = lat_[static_cast<size_t>(p)].link;
         long q = p;  // [p, q): link l's entries
         while (q < p1 && lat_[static_cast<size_t>(q)].link == l) ++q;
-        if (R == 2) w_rows<2>(i, p - lat_ptr_[i], q - p, v);
-        else w_rows<1>(i, p - lat_ptr_[i], q - p, v);
+        if (R == 2) w_rows<2>(i, p - modal_ptr_[i], q - p, v);
+        else w_rows<1>(i, p - modal_ptr_[i], q - p, v);
         p = q;
       }
       i += R - 1;
     }
   });
-  for (int l = 0; l < L; ++l)  // Φ_lᵀ W_l' in column blocks, W_l' at link l's lateral rows
+  for (int l = 0; l < L; ++l)  // Φ_lᵀ W_l' in column blocks, W_l' at link l's modal rows
     for (int l2 = 0; l2 < L; ++l2) {
       const size_t p = static_cast<size_t>(l * L + l2);
       const RowMat& W = W_[static_cast<size_t>(l2)];
-      const auto wb = W.middleRows(lateral_first_[static_cast<size_t>(l)], links[l].phi_rows.rows());
+      const auto wb = W.middleRows(modal_first_[static_cast<size_t>(l)], links[l].phi_rows.rows());
       MatX& G = G_[p];
       G.resize(links[l].phi.cols(), W.cols());
       const long blocks = (W.cols() + kGramBlock - 1) / kGramBlock;
@@ -434,16 +433,7 @@ bool ReducedFactor::factorize(const SparseMat& S, int kept, bool definite, int t
         if (it.row() >= c && it.row() < kept) t.emplace_back(static_cast<int>(it.row()), c, 0.0);
     T_.resize(kept, kept);
     T_.setFromTriplets(t.begin(), t.end());
-    // A tridiagonal T (a reduced link's x1 chain alone) is eliminated in its own order, two sweeps
-    // a solve; any other by a sparse LDLᵀ in AMD order (whose permutations and index lists made the
-    // chain's 60 solves a step 4 % of a reduced run's CPU time).
-    tridiagonal_ = kept > 0;
-    for (int c = 0; c < kept && tridiagonal_; ++c) {
-      const int* row = T_.innerIndexPtr() + T_.outerIndexPtr()[c];
-      const long len = T_.outerIndexPtr()[c + 1] - T_.outerIndexPtr()[c];
-      tridiagonal_ = len >= 1 && row[0] == c && (len == 1 || (len == 2 && row[1] == c + 1));
-    }
-    if (kept > 0 && !tridiagonal_) t_.analyzePattern(T_);
+    if (kept > 0) t_.analyzePattern(T_);  // (a sparse LDLᵀ in AMD order)
     nnz_ = S.nonZeros();
     size_ = n;
     kept_ = kept;
@@ -463,33 +453,12 @@ bool ReducedFactor::factorize(const SparseMat& S, int kept, bool definite, int t
     for (SparseMat::InnerIterator it(S, kept + c); it; ++it)
       if (it.row() >= kept) schur_(it.row() - kept, c) = it.value();
   if (kept > 0) {
-    if (tridiagonal_) {
-      td_.resize(kept);
-      tl_.resize(kept);
-      const int* outer = T_.outerIndexPtr();
-      const double* tv = T_.valuePtr();
-      auto sub = [&](int c) { return outer[c + 1] - outer[c] == 2 ? tv[outer[c] + 1] : 0.0; };  // T(c + 1, c)
-      td_[0] = tv[outer[0]];
-      tl_[0] = 0.0;
-      for (int i = 1; i < kept; ++i) {
-        tl_[i] = sub(i - 1) / td_[i - 1];
-        td_[i] = tv[outer[i]] - tl_[i] * sub(i - 1);
-      }
-      if (!td_.allFinite() || (definite ? !(td_.array() > 0.0).all() : !(td_.array() != 0.0).all())) return false;
-    } else {
-      t_.factorize(T_);
-      if (t_.info() != Eigen::Success) return false;
-      if (definite && !(t_.vectorD().array() > 0.0).all()) return false;
-    }
-    // Yᵀ = (T⁻¹ B)ᵀ a border column at a time (kSweeps together if T is tridiagonal), then the Schur
-    // complement's upper triangle by rows.
+    t_.factorize(T_);
+    if (t_.info() != Eigen::Success) return false;
+    if (definite && !(t_.vectorD().array() > 0.0).all()) return false;
+    // Yᵀ = (T⁻¹ B)ᵀ a border column at a time, then the Schur complement's upper triangle by rows.
     Yt_.resize(nb, kept);
     for_team_items(nb, team, [&](long b, long e) {
-      if (tridiagonal_) {
-        Yt_.middleRows(b, e - b) = Bt_.middleRows(b, e - b);
-        for (long i = b; i < e; i += kSweeps) t_solve(Yt_.row(i).data(), Yt_.cols(), static_cast<int>(std::min<long>(kSweeps, e - i)));
-        return;
-      }
       VecX y;
       for (long i = b; i < e; ++i) {
         y = t_.solve(Bt_.row(i).transpose());
@@ -513,18 +482,6 @@ bool ReducedFactor::factorize(const SparseMat& S, int kept, bool definite, int t
   return true;
 }
 
-// L D Lᵀ x = b in place for `count` vectors `stride` apart, L unit lower bidiagonal; the vectors'
-// sweeps interleaved (each sweep is a chain of dependent operations: several hide its latency).
-void ReducedFactor::t_solve(double* x, long stride, int count) const {
-  const long n = td_.size();
-  for (long i = 1; i < n; ++i)
-    for (int c = 0; c < count; ++c) x[c * stride + i] -= tl_[i] * x[c * stride + i - 1];
-  for (int c = 0; c < count; ++c)
-    for (long i = 0; i < n; ++i) x[c * stride + i] /= td_[i];
-  for (long i = n - 2; i >= 0; --i)
-    for (int c = 0; c < count; ++c) x[c * stride + i] -= tl_[i + 1] * x[c * stride + i + 1];
-}
-
 void ReducedFactor::solve(VecX& b, int team) const {
   const int kept = kept_, nb = size_ - kept_;
   if (kept == 0) {
@@ -534,8 +491,7 @@ void ReducedFactor::solve(VecX& b, int team) const {
   // (into b itself: 12–13 solves a step, no vector allocated)
   auto x1 = b.head(kept);
   auto x2 = b.tail(nb);
-  if (tridiagonal_) t_solve(x1.data(), 0, 1);  // T⁻¹ b1
-  else x1 = t_.solve(x1);                  // (a sparse LDLᵀ solves in place)
+  x1 = t_.solve(x1);  // T⁻¹ b1 (a sparse LDLᵀ solves in place)
   for_team_items(nb, team, [&](long s, long e) {  // b2 − Bᵀ T⁻¹ b1
     for (long i = s; i < e; ++i) x2[i] -= Bt_.row(i).dot(x1);
   });

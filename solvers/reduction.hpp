@@ -1,19 +1,22 @@
 #pragma once
 // Modal reduction of flexible links (docs/formulation.md §9). A link with `modes = m` keeps, instead
-// of its rfes' 5n lateral and rotational coordinates (x2, x3, φ1, φ2, φ3), m modal coordinates η:
-//   q_l = q_l0 + Φ_l η_l,
-// Φ_l its first m modes clamped in {r} (every joint held at the initial values, every other link
-// rigid; its sections and payloads as given; M-normalised), q_l0 the static equilibrium they are
-// taken about; their x1 rows are left out. Each rfe's axial coordinate x1 stays an unknown: a bent
-// link's rfes must be free to draw closer along its axis, or the stiff axial sdes resist every
-// deflection at second order (membrane locking: Kane's spin-up then deflects 0.12 m instead of
-// 0.57 m), and with them the centrifugal tension that stiffens a rotating link stays. (Modes taken
-// with x1 held instead are wrong where a section's centroid is offset: bending then moves x1.) The equations are projected (Galerkin): r_η = Φ_lᵀ r_l, so the full nonlinear
-// kinematics, the base coupling and centrifugal effects stay; only the shapes the link can take are
-// limited. Over a coordinate vector of 6n rfe coordinates followed by k joint coordinates,
+// of its rfes' 3n rotations (φ1, φ2, φ3), m modal coordinates η:
+//   φ_l = φ_l0 + Φ_l η_l,
+// Φ_l the rotation rows of its first m modes clamped in {r} (every joint held at the initial values,
+// every other link rigid; its sections and payloads as given; M-normalised) whose rotations add a
+// direction, φ_l0 those of the static equilibrium they are taken about. Each rfe's displacements
+// x1, x2, x3 stay unknowns: a bent link's rfes must be free to follow their rotations rigidly
+// (shorten along the axis, move across it by the sine of the angle), which a linear combination of
+// displacement modes cannot do: the stiff shear and axial sdes then resist the difference at second
+// and third order, and a spinning link locks (Kane's spin-up 4.3 % low at 6 rad/s with 8 to 250 of
+// 300 modes when the modes spanned x2, x3 too). The equations are projected (Galerkin):
+// r_η = Φ_lᵀ r_l, so the full nonlinear kinematics, the base coupling and centrifugal effects stay;
+// only the rotations the link can take are limited, and with m = 3n it is the full model. Over a
+// coordinate vector of 6n rfe coordinates followed by k joint coordinates,
 //   x_full = P x (+ q0 for positions),   P = blockdiag(links kept whole: I; reduced: Φ_l; joints: I).
-// Reduced unknowns are ordered: the rfe coordinates kept (links kept whole, reduced links' x1; model
-// order), each reduced link's η, then the joints. Immutable once built; shared by the equations, statics and modes.
+// Reduced unknowns are ordered: the rfe coordinates kept (links kept whole, reduced links'
+// displacements; model order), each reduced link's η, then the joints. Immutable once built; shared
+// by the equations, statics and modes.
 #include <memory>
 #include <string>
 #include <vector>
@@ -36,7 +39,7 @@ class Reduction {
     int link = 0;           ///< the model's link
     int first = 0;          ///< its first column among the reduced rfe unknowns
     std::vector<int> rfe;   ///< first full coordinate of each of its rfes
-    MatX phi;               ///< 5n × (m + its derivatives), rows rfe by rfe (k = 0 … n − 1), axes x2 … φ3
+    MatX phi;               ///< 3n × (m + its derivatives), rows rfe by rfe (k = 0 … n − 1), axes φ1 … φ3
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> phi_rows;  ///< Φ_l row-major (lift, project)
     MatX mass_phi;          ///< M_bb Φ_l over the same coordinates
     Eigen::LLT<MatX> gram;  ///< of Φ_lᵀ M_bb Φ_l: the M-orthogonal projection back, G η = (M Φ)ᵀ (q − q0)
@@ -67,7 +70,7 @@ class Reduction {
                   int team = 1) const;
   /// lift_state of an ESDIRK stage's Q = Qk + (hγ)² A, V = Vk + hγ A from Qk, Vk lifted once (qk, vk:
   /// lift_state's qf, vf of them) and A alone: one pass over Φ instead of three. The kept and joint
-  /// coordinates are Q's, V's, A's; the reduced links' lateral ones equal lift_state's to round-off.
+  /// coordinates are Q's, V's, A's; the reduced links' modal ones equal lift_state's to round-off.
   void lift_stage(const double* Q, const double* V, const double* A, const double* qk, const double* vk, double hg,
                   double* qf, double* vf, double* af, int k, int team = 1) const;
   /// r = Pᵀ r_full; on `team` threads (Φᵀ r summed over fixed blocks of rfes in order: the same
@@ -87,8 +90,8 @@ class Reduction {
   const std::vector<int>& quasi_static() const { return quasi_static_; }
 
  private:
-  template <class Kept, class Lateral>
-  void for_lifted(const double* const* x, int cols, int team, Kept&& kept, Lateral&& lateral) const;
+  template <class Kept, class Modal>
+  void for_lifted(const double* const* x, int cols, int team, Kept&& kept, Modal&& modal) const;
   int full_rfe_ = 0, rfe_ = 0;
   std::vector<int> kept_;  ///< full index of each kept rfe coordinate (they come first)
   std::vector<Link> links_;
@@ -98,7 +101,7 @@ class Reduction {
 /// Pᵀ S P for matrices S on one pattern, again and again. Its layout is fixed once: S's compressed
 /// columns (both triangles) with each value's slot in the pattern, and the reduced matrix's pattern
 /// with the source of each entry. Each call then gathers S's values, forms W_l = S Φ_l (S sparse,
-/// Φ_l dense over link l's lateral rows: nnz · m) and reads every reduced entry off S (kept × kept),
+/// Φ_l dense over link l's modal rows: nnz · m) and reads every reduced entry off S (kept × kept),
 /// W_l (kept × η_l) or Φ_lᵀ W_l' (η_l × η_l'), in place — a generic sparse product with Φ's dense
 /// columns cost 3× more per step (docs/performance.md, "Reduced links").
 class Projection {
@@ -121,25 +124,25 @@ class Projection {
   using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   std::vector<int> link_of_;    // per full coordinate: its reduced link (−1: kept)
   std::vector<int> phi_row_;    // per full coordinate of a reduced link: its row of Φ_l
-  struct Lateral {     // an entry of S in a reduced link's lateral row
+  struct Modal {     // an entry of S in a reduced link's modal row
     long value;        // its index in S_'s values
     int link, phi_row; // the link and the row of Φ_l
   };
-  std::vector<long> lat_ptr_;   // column i's lateral entries: lat_[lat_ptr_[i] … lat_ptr_[i + 1])
-  std::vector<Lateral> lat_;
-  std::vector<char> twin_;      // column i's lateral entries in the same rows of Φ as column i + 1's
+  std::vector<long> modal_ptr_;   // column i's modal entries: lat_[modal_ptr_[i] … modal_ptr_[i + 1])
+  std::vector<Modal> lat_;
+  std::vector<char> twin_;      // column i's modal entries in the same rows of Φ as column i + 1's
   template <int R>
   void w_rows(long i, long skip, long count, const double* v);
   std::vector<RowMat> W_;       // S Φ_l over every full row (row i from S's column i: S is symmetric; rows by w_row_)
-  std::vector<int> w_row_;      // per full coordinate: its row of W_l (kept ones first, then each link's lateral rows)
-  std::vector<int> lateral_first_;  // per link: W's row of its first lateral coordinate
+  std::vector<int> w_row_;      // per full coordinate: its row of W_l (kept ones first, then each link's modal rows)
+  std::vector<int> modal_first_;  // per link: W's row of its first modal coordinate
   std::vector<MatX> G_;         // Φ_lᵀ W_l' per link pair (l·links + l')
 };
 
 /// Factor of a reduced (sparse, symmetric) matrix S = [T B; Bᵀ D] split after its `kept` leading
-/// unknowns: T over the rfe coordinates kept (sparse: the x1 chain of a reduced link, the links kept
-/// whole), B and D dense over the modal coordinates and joints that border it. T by a sparse LDLᵀ
-/// (its ordering analysed once per pattern; a tridiagonal T, x1's chain alone, in its own order), then the Schur complement D − Bᵀ T⁻¹ B by a dense
+/// unknowns: T over the rfe coordinates kept (sparse: a reduced link's displacements, the links
+/// kept whole), B and D dense over the modal coordinates and joints that border it. T by a sparse
+/// LDLᵀ (its ordering analysed once per pattern), then the Schur complement D − Bᵀ T⁻¹ B by a dense
 /// LDLᵀ; a solve is one sparse solve with T and two products with the border on the team (a sparse
 /// LDLᵀ of the whole S filled T's rows with the border and solved it serially: 13 solves a step,
 /// the second thread waiting; docs/performance.md, "Reduced links"). Each product's entries are
@@ -158,9 +161,6 @@ class ReducedFactor {
   RowMat Bt_, Yt_;    // Bᵀ and (T⁻¹ B)ᵀ, border × kept
   MatX schur_;        // D − Bᵀ T⁻¹ B
   Eigen::LDLT<MatX> s_;
-  bool tridiagonal_ = false;  // T tridiagonal: factorised below instead of by t_
-  VecX td_, tl_;              // its D, and L's subdiagonal (tl_[i] = L(i, i − 1))
-  void t_solve(double* x, long stride, int count) const;
   long nnz_ = -1;
   int size_ = -1, kept_ = -1;
 };

@@ -54,7 +54,7 @@ ModelSummary show_model(const Case& cs, int n) {
   s.m = M.m();
   s.dof = M.dof();
   s.unknowns = M.flexible_dofs();
-  // A reduced link's unknowns are its axial coordinates, its modes and their derivatives: the
+  // A reduced link's unknowns are its rfes' displacements, its modes and their derivatives: the
   // reduction says how many (its modes taken where the equations take them).
   if (const auto red = Reduction::of(M, initial_joint_values(M, joint_inputs(cs)))) s.unknowns = red->rfe();
   for (const InputSpec& in : cs.inputs) s.unknowns += in.prescribed() ? 0 : 1;
@@ -114,9 +114,9 @@ ModelSummary show_model(const Case& cs, int n) {
                                 parts[l][g] > 1 ? "s" : "");
       }
       if (L.d.modes > 0)
-        e.detail += fmt::format("; reduced: {} mode{}{} and its {} axial coordinates", L.d.modes, L.d.modes > 1 ? "s" : "",
+        e.detail += fmt::format("; reduced: {} mode{} of its rotations{} and its {} displacements", L.d.modes, L.d.modes > 1 ? "s" : "",
                                 L.d.derivatives > 0 ? fmt::format(", at most {} modal derivatives", L.d.derivatives * (L.d.derivatives + 1) / 2) : "",
-                                L.n());
+                                kModalFirst * L.n());
       std::vector<int> idx;  // its rfes' coordinates (an rfe that carries something sits in the border)
       for (int r = 0; r < L.n(); ++r)
         for (int a = 0; a < Model::rfe_dofs; ++a) idx.push_back(M.rfe_index(l, r) + a);
