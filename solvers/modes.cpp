@@ -229,6 +229,24 @@ ModesResult compute_modes(const Model& model, const VecX& qb, const VecX& vb, in
 
 namespace {
 
+// x's rotation rows over link l of the sub-model, rfe by rfe: what a reduced link's columns span.
+VecX rotation_rows(const Model& sub, int l, const VecX& x) {
+  const int n = sub.links[l].n();
+  VecX y(kModalAxes * n);
+  for (int k = 0; k < n; ++k) y.segment<kModalAxes>(kModalAxes * k) = x.segment<kModalAxes>(sub.rfe_index(l, k) + kModalFirst);
+  return y;
+}
+
+// Appends r's direction to the orthonormal columns Q if, orthogonalised against them, more than
+// kNewDirection · reference of it is left (less is round-off of a direction Q holds); says whether.
+bool add_direction(MatX& Q, VecX r, double reference) {
+  for (int pass = 0; pass < 2; ++pass) r -= Q * (Q.transpose() * r);  // (twice: classical Gram–Schmidt)
+  if (!(r.norm() > kNewDirection * reference)) return false;
+  Q.conservativeResize(Q.rows(), Q.cols() + 1);
+  Q.col(Q.cols() - 1) = r / r.norm();
+  return true;
+}
+
 // Static modal derivatives (docs/formulation.md §9) of the picked modes i ≤ j < p of link l of the
 // sub-model: K θ_ij = −∂²f/∂η_i∂η_j, f the static forces (sdes, gravity) about the equilibrium
 // all.q0 and K = ∂f/∂q there. The second derivative by central differences along φ_i ± φ_j with the
@@ -260,11 +278,6 @@ void add_modal_derivatives(const Model& sub, int l, const std::shared_ptr<const 
     generalised_forces(sub, q, z, z, ft, f, nullptr, &ws);
     return VecX(f.head(nf));
   };
-  auto rotations = [&](const VecX& x) {
-    VecX y(N);
-    for (int k = 0; k < n; ++k) y.segment<kModalAxes>(kModalAxes * k) = x.segment<kModalAxes>(sub.rfe_index(l, k) + kModalFirst);
-    return y;
-  };
   // An orthonormal basis of the columns so far: a derivative they (nearly) span adds nothing.
   MatX Q = Eigen::HouseholderQR<MatX>(out.shapes).householderQ() * MatX::Identity(N, out.shapes.cols());
   for (int i = 0; i < p; ++i)
@@ -273,13 +286,9 @@ void add_modal_derivatives(const Model& sub, int l, const std::shared_ptr<const 
       const double h = 1e-3 / std::max(a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff());
       VecX theta = -(forces(h * (a + b)) - forces(h * (a - b)) - forces(h * (b - a)) + forces(-h * (a + b))) / (4 * h * h);
       solver->solve(theta);
-      const VecX rot = rotations(theta);
-      VecX r = rot;
-      for (int pass = 0; pass < 2; ++pass) r -= Q * (Q.transpose() * r);  // (twice: classical Gram–Schmidt)
-      if (!(r.norm() > kNewDirection * rot.norm())) continue;
-      r /= r.norm();
-      Q.conservativeResize(N, Q.cols() + 1);
-      Q.col(Q.cols() - 1) = r;
+      const VecX rot = rotation_rows(sub, l, theta);
+      if (!add_direction(Q, rot, rot.norm())) continue;
+      const VecX r = Q.col(Q.cols() - 1);
       // The column: its new direction, scaled to a largest coordinate of 1; M_bb of it.
       VecX full = VecX::Zero(nf), Mr;
       for (int k = 0; k < n; ++k) full.segment<kModalAxes>(sub.rfe_index(l, k) + kModalFirst) = r.segment<kModalAxes>(kModalAxes * k);
@@ -289,7 +298,7 @@ void add_modal_derivatives(const Model& sub, int l, const std::shared_ptr<const 
       out.shapes.conservativeResize(N, c + 1);
       out.mass_shapes.conservativeResize(N, c + 1);
       out.shapes.col(c) = s * r;
-      out.mass_shapes.col(c) = s * rotations(Mr);
+      out.mass_shapes.col(c) = s * rotation_rows(sub, l, Mr);
       out.pairs.emplace_back(i + 1, j + 1);
     }
 }
@@ -329,18 +338,9 @@ LinkModes link_modes(const Model& model, int l, const VecX& qb, int count, int d
     pick.clear();
     MatX Q(N, 0);  // an orthonormal basis of the picked modes' rotation rows
     for (int i = 0; i < want && static_cast<int>(pick.size()) <= count; ++i) {
-      VecX r(N);
       double norm = 0.0;  // of the mode over all its link's coordinates: an axial mode's rotations are round-off of it
-      for (int k = 0; k < n; ++k) {
-        r.segment<kModalAxes>(kModalAxes * k) = all.shapes.col(i).segment<kModalAxes>(sub.rfe_index(l, k) + kModalFirst);
-        norm += all.shapes.col(i).segment<Model::rfe_dofs>(sub.rfe_index(l, k)).squaredNorm();
-      }
-      norm = std::sqrt(norm);
-      for (int pass = 0; pass < 2; ++pass) r -= Q * (Q.transpose() * r);  // (twice: classical Gram–Schmidt)
-      if (!(r.norm() > kNewDirection * norm)) continue;
-      pick.push_back(i);
-      Q.conservativeResize(N, Q.cols() + 1);
-      Q.col(Q.cols() - 1) = r / r.norm();
+      for (int k = 0; k < n; ++k) norm += all.shapes.col(i).segment<Model::rfe_dofs>(sub.rfe_index(l, k)).squaredNorm();
+      if (add_direction(Q, rotation_rows(sub, l, all.shapes.col(i)), std::sqrt(norm))) pick.push_back(i);
     }
     if (static_cast<int>(pick.size()) > count || want == N6) break;
   }
