@@ -6,6 +6,7 @@
 
 #include "../simulation/inputs.hpp"
 #include "../simulation/recorders.hpp"
+#include "../studies/reduction_error.hpp"
 #include "../studies/resume.hpp"
 #include "../studies/run_file.hpp"
 #include "commands.hpp"
@@ -79,7 +80,13 @@ int report(const std::string& case_path, long n, const std::string& output, cons
     nlohmann::json js = nlohmann::json::array();
     for (const auto& r : runs) {
       nlohmann::json links = nlohmann::json::array();
-      for (const LinkPeaks& p : r.peaks) links.push_back({{"name", p.name}, {"peak_u1", p.u1}, {"peak_u2", p.u2}, {"peak_theta", p.theta}});
+      for (size_t l = 0; l < r.peaks.size(); ++l) {
+        const LinkPeaks& p = r.peaks[l];
+        links.push_back({{"name", p.name}, {"peak_u1", p.u1}, {"peak_u2", p.u2}, {"peak_theta", p.theta}});
+        if (l < r.reduction_error.size())
+          links.back()["reduction_error"] = {{"n", r.reduction_n}, {"u1", r.reduction_error[l].u1},
+                                             {"u2", r.reduction_error[l].u2}, {"theta", r.reduction_error[l].theta}};
+      }
       js.push_back({{"name", r.name}, {"status", r.status.to_string()}, {"completed", r.completed()}, {"t_reached", r.t_reached},
                     {"outputs", r.samples}, {"wall_time_s", r.wall_s}, {"steps", r.stats.steps},
                     {"residual_evals", r.stats.residual_evals}, {"factorizations", r.stats.factorizations},
@@ -93,6 +100,10 @@ int report(const std::string& case_path, long n, const std::string& output, cons
     if (!accuracy.is_null()) out["accuracy"] = accuracy;
     print_json(out);
   } else if (!quiet) {
+    for (const RunResult& r : runs)
+      for (const LinkPeaks& e : r.reduction_error)
+        fmt::print("{:<10} {}reduction error (estimated: reduced - full peaks at n = {}): u1 {:+.2e} m, u2 {:+.2e} m, theta {:+.2e} rad\n",
+                   r.name, r.reduction_error.size() > 1 ? "link " + e.name + ": " : "", r.reduction_n, e.u1, e.u2, e.theta);
     fmt::print("results in {}\n", output);
     for (const std::string& x : xdmf) fmt::print("ParaView: {}\n", x);
   }
@@ -118,6 +129,7 @@ int resume_simulation(const Common& c, const RunOptions& o) {
     if (plan.finished()) fmt::print("every run had completed: nothing to do\n");
   }
   RunRequest rq;
+  rq.reduction_error = !o.no_reduction_check;
   const SignalStop signals(rq.stop);
   Console console(quiet);
   console.attach(rq, c, o);
@@ -158,10 +170,12 @@ int run_simulation(const Common& c, const RunOptions& o) {
   const bool quiet = c.json || c.quiet;
   RunRequest rq;
   rq.n = c.n;
+  if (target.relative > 0.0) rq.reduction_allowed = target.relative;
+  rq.reduction_error = !o.no_reduction_check;
   const SignalStop signals(rq.stop);
   Console console(quiet);
   console.attach(rq, c, o);
-  const std::optional<AccuracyResult> acc = choose_by_target(given, target, c, rq, console, quiet);
+  std::optional<AccuracyResult> acc = choose_by_target(given, target, c, rq, console, quiet);
   if (acc && !acc->refinement.status.is_completed()) {  // (stopped by a signal during the ladder)
     fmt::print(stderr, "rfem: the search for n towards the target was {}\n", acc->refinement.status.to_string());
     return 128 + std::max(acc->refinement.status.signal, 2);
@@ -179,6 +193,7 @@ int run_simulation(const Common& c, const RunOptions& o) {
   });
   const bool completed = !f.runs.empty() && f.runs.back().completed();
   if (acc && completed) {
+    add_reduction_error(*acc, f.runs);
     write_accuracy(o.output, *acc);
     if (!c.json) print_accuracy(*acc);  // (results: also with -q)
   }

@@ -61,6 +61,7 @@ struct RunOptions {
   std::string output;       ///< the results file
   std::string resume;       ///< --resume RESULTS.h5: continue that file's runs instead
   double checkpoint = 0.0;  ///< wall time between checkpoints [s] (0: none)
+  bool no_reduction_check = false;  ///< --no-reduction-check: no companion runs for a reduced link's error
 };
 /// `rfem run`: time integration of the case's [simulation], results to an HDF5 file; or, with
 /// --resume, the runs an interrupted or killed `rfem run` left, from their checkpoints.

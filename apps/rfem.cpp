@@ -139,6 +139,8 @@ int main(int argc, char** argv) {
   rn->add_option("--checkpoint", run_options.checkpoint,
                  fmt::format("seconds of wall time between checkpoints (0: none; default {:g})", rfem::kCheckpointInterval))
       ->check(kNonNegativeFinite);
+  rn->add_flag("--no-reduction-check", run_options.no_reduction_check,
+               "with reduced links: skip the full and reduced runs at a coarse n that estimate the reduction's error");
   auto* pl = app.add_subcommand("plot", "PNG figures of a results file (the paper's Figures 5-8, runs, refinement)");
   std::string plot_file, plot_dir;
   pl->add_option("results", plot_file, "results file (HDF5) from rfem run or rfem refine")->required();

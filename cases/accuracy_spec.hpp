@@ -10,6 +10,9 @@ namespace rfem {
 /// The tightest relative target rfem certifies: below it the integrator's tolerances (rtol =
 /// target/1000 would pass 1e-11) and round-off in the values put the time error near the target.
 inline constexpr double kMinRelativeTarget = 1e-8;
+/// The accuracy a run without a target aims at: 1e-4 of each series' scale (docs/accuracy.md, "The
+/// default tolerances, measured").
+inline constexpr double kDefaultsAim = 1e-4;
 
 struct AbsoluteTarget {
   std::string quantity;  ///< a quantity (studies/quantities.hpp), e.g. "peak:u1"

@@ -11,7 +11,10 @@ displacements; the three rotations of the 60 rfes (180) become the m modal ampli
    converge as m grows (m = 8 within 1.3e-3, m = 16 within 8.6e-5). Segment B1 is nearly free to
    twist (J = 2.2e-11 m⁴ as the paper prints it) and part of its twist is second order in the
    bending: the static derivatives of the first 6 modes (`link.derivatives = 6`, docs/formulation.md
-   §9: 18 second-order shapes more) bring θ within 6.3e-5 with 8 modes,
+   §9: 18 second-order shapes more) bring θ within 6.3e-5 with 8 modes; beside each distance, the
+   run's own estimate of it (Run.reduction_error: the full and the reduced model at n = 30), which
+   a user without the full run has: within a factor of 2 above 1e-4 of a peak, its order only below
+   (the force run's small errors change with n by as much as their size; docs/accuracy.md),
 3. the force run's tip u1 at a few times, full against m = 8 with and without the derivatives, and
    the energy balance (the work of the joint torques against T + V: the Galerkin projection
    conserves what the full model does).
@@ -22,7 +25,7 @@ force run 5 677 steps, 2.8 s (full); 2 499, 1.2 s (m = 4); 4 456, 2.4 s (m = 8);
 where the reduced force run costs 1.17–1.23× the full one at the same tolerances (README, "Reduced
 links").
 
-    PYTHONPATH=build/python /usr/bin/python3 examples/ex15_reduced_force.py        (~8 s)
+    PYTHONPATH=build/python /usr/bin/python3 examples/ex15_reduced_force.py        (~16 s)
 """
 import os
 
@@ -56,14 +59,18 @@ for c in CONFIGS:
         s = run.stats
         print(f"# {r:<9}: {s['steps']:5d} steps, {s['residual_evals']:6d} residual evaluations, wall time {run.wall_time:.2f} s")
 
-print("peaks of the tip (full) and the reduced runs' relative distance from them")
+print("peaks of the tip (full) and the reduced runs' relative distance from them, each beside the run's own")
+print("estimate (Run.reduction_error: the full and the reduced model at n = N/2; README, \"Reduced links\")")
 for r in ("kinematic", "force"):
     full = results[(0, 0)][r].peaks["link"]
     print(f"  {r}: full |u1| = {full['u1']:.6e} m, |u2| = {full['u2']:.6e} m, |theta| = {full['theta']:.6e} rad")
     for c in CONFIGS[1:]:
         p = results[c][r].peaks["link"]
         d = [abs(p[k] - full[k]) / full[k] for k in ("u1", "u2", "theta")]
-        print(f"    {label(c)}: u1 {d[0]:.1e}, u2 {d[1]:.1e}, theta {d[2]:.1e}")
+        e = results[c][r].reduction_error["link"]
+        est = [abs(e[k]) / full[k] for k in ("u1", "u2", "theta")]
+        print(f"    {label(c)}: u1 {d[0]:.1e} (est. {est[0]:.1e}), u2 {d[1]:.1e} (est. {est[1]:.1e}), "
+              f"theta {d[2]:.1e} (est. {est[2]:.1e}), at n = {e['n']}")
         if c[1]:
             assert max(d) < 1e-3, d
 

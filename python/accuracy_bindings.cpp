@@ -5,6 +5,7 @@
 #include <pybind11/stl.h>
 
 #include "../studies/accuracy.hpp"
+#include "../studies/reduction_error.hpp"
 #include "arguments.hpp"
 #include "call_guard.hpp"
 
@@ -22,6 +23,7 @@ py::dict estimate_dict(const Estimate& e) {
   d["error"] = e.error;
   d["error_space"] = e.error_space;
   d["error_time"] = e.error_time;
+  d["error_reduction"] = e.error_reduction;
   d["observed_order"] = e.observed_order;
   d["asymptotic"] = e.asymptotic;
   d["zero"] = e.zero;
@@ -37,7 +39,7 @@ void bind_accuracy(py::module_& m) {
       m, "Accuracy",
       "What a target accuracy chose and what it achieved (accuracy= on rfem.run, rfem.modes, rfem.static): n, the "
       "tolerances, and per value its error bar; acc[\"peak:run/u1\"] is one value's dict (value, error, error_space, "
-      "error_time, observed_order, asymptotic, zero, allowed, met).")
+      "error_time, error_reduction, observed_order, asymptotic, zero, allowed, met).")
       .def_readonly("n", &AccuracyResult::n)
       .def_readonly("rtol", &AccuracyResult::rtol, "the chosen tolerances (NaN: no time integration)")
       .def_readonly("atol", &AccuracyResult::atol)
@@ -106,6 +108,13 @@ void bind_accuracy(py::module_& m) {
     return py::make_tuple(py::cast(a), error);
   }, py::arg("case"), py::arg("command"), py::arg("accuracy"), py::arg("max_n"), py::arg("max_time"), py::arg("n"), py::arg("count"), py::arg("rate"),
      py::arg("joint"), py::arg("threads"), py::arg("progress"), py::arg("free") = py::none());
+
+  m.def("_add_reduction_error", [](AccuracyResult& a, const std::vector<std::shared_ptr<RunResult>>& runs) {
+    std::vector<RunResult> rs;
+    for (const auto& r : runs)
+      if (r) rs.push_back(*r);
+    add_reduction_error(a, rs);
+  }, py::arg("accuracy"), py::arg("runs"));
 
   m.def("_write_accuracy", [](args::Typed<"Union[str, os.PathLike]"> path, const AccuracyResult& a) {
     const std::string p = args::path(path, "output");

@@ -16,7 +16,7 @@ namespace rfem::pyorigin {
 
 namespace {
 
-constexpr int kCaseVersion = 1, kModelVersion = 1, kRunVersion = 1, kSweepVersion = 1;
+constexpr int kCaseVersion = 1, kModelVersion = 1, kRunVersion = 2, kSweepVersion = 1;
 
 struct Origin {
   std::weak_ptr<const Model> model;
@@ -197,6 +197,8 @@ py::tuple run_state(const RunResult& r) {
   const IntegratorStats& s = r.stats;
   py::list peaks;
   for (const LinkPeaks& p : r.peaks) peaks.append(py::make_tuple(p.name, p.u1, p.u2, p.theta));
+  py::list reduction;
+  for (const LinkPeaks& p : r.reduction_error) reduction.append(py::make_tuple(p.name, p.u1, p.u2, p.theta));
   py::object model = py::none();
   {
     std::lock_guard<std::mutex> lock(registry_mutex);
@@ -206,7 +208,7 @@ py::tuple run_state(const RunResult& r) {
       kRunVersion, r.name, r.status.to_string(), r.wall_s, r.t_reached,
       py::make_tuple(s.steps, s.residual_evals, s.factorizations, s.newton_iters, s.newton_fails, s.error_test_fails, s.last_step),
       r.samples, peaks, r.energy_drift, r.energy_scale, r.warnings, model, series_state(r.series.get()),
-      py::make_tuple(r.sensors.rows, r.sensors.cols, numbers(r.sensors.data)), r.sensor_columns, r.sensor_units);
+      py::make_tuple(r.sensors.rows, r.sensors.cols, numbers(r.sensors.data)), r.sensor_columns, r.sensor_units, reduction, r.reduction_n);
 }
 
 std::shared_ptr<RunResult> run_from(const py::tuple& t) {
@@ -235,7 +237,7 @@ std::shared_ptr<RunResult> run_from(const py::tuple& t) {
 }
 
 std::shared_ptr<RunResult> run_from_unchecked(const py::tuple& t) {
-  check_version(t, kRunVersion, 16, "Run");
+  check_version(t, kRunVersion, 18, "Run");
   auto r = std::make_shared<RunResult>();
   r->name = t[1].cast<std::string>();
   r->status = RunStatus::parse(t[2].cast<std::string>());
@@ -260,6 +262,11 @@ std::shared_ptr<RunResult> run_from_unchecked(const py::tuple& t) {
   r->sensors.data = numbers_from(sensors[2]);
   r->sensor_columns = t[14].cast<std::vector<std::string>>();
   r->sensor_units = t[15].cast<std::vector<std::string>>();
+  for (py::handle p : t[16].cast<py::list>()) {
+    const auto pt = p.cast<py::tuple>();
+    r->reduction_error.push_back(LinkPeaks{pt[0].cast<std::string>(), pt[1].cast<double>(), pt[2].cast<double>(), pt[3].cast<double>()});
+  }
+  r->reduction_n = t[17].cast<int>();
   return r;
 }
 

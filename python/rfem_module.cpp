@@ -227,6 +227,14 @@ PYBIND11_MODULE(_rfem, m) {
         for (const auto& p : r.peaks) d[py::str(p.name)] = py::dict(py::arg("u1") = p.u1, py::arg("u2") = p.u2, py::arg("theta") = p.theta);
         return d;
       }, "dict: per link, peak |u1|, |u2| [m], |theta| [rad]")
+      .def_property_readonly("reduction_error", [](const RunResult& r) -> py::object {
+        if (r.reduction_n == 0) return py::none();
+        py::dict d;
+        for (const auto& p : r.reduction_error)
+          d[py::str(p.name)] = py::dict(py::arg("u1") = p.u1, py::arg("u2") = p.u2, py::arg("theta") = p.theta, py::arg("n") = r.reduction_n);
+        return d;
+      }, "a run of reduced links: per link, its peaks' estimated reduction error (reduced - full peaks, both at the "
+         "coarse n given as 'n'; README, \"Reduced links\"); None without one")
       .def_readonly("energy_drift", &RunResult::energy_drift, "max |balance(t) - balance(0)| [J]")
       .def_readonly("warnings", &RunResult::warnings, "where the solution left the small deformation the model assumes")
       .def_readonly("energy_scale", &RunResult::energy_scale, "[J]")
@@ -289,7 +297,8 @@ PYBIND11_MODULE(_rfem, m) {
       .def(py::pickle(&pyorigin::run_state, &pyorigin::run_from));
 
   m.def("_run", [](args::Typed<"Union[Case, str, os.PathLike]"> case_arg, args::Typed<"Optional[int]"> n_arg, args::Typed<"Optional[Union[str, os.PathLike]]"> output_arg, args::Typed<"Optional[List[str]]"> runs, args::Typed<"int"> threads,
-                   args::Typed<"bool"> keep_series, args::Typed<"Optional[Callable[[dict], Any]]"> progress, args::Typed<"float"> checkpoint) {
+                   args::Typed<"bool"> keep_series, args::Typed<"Optional[Callable[[dict], Any]]"> progress, args::Typed<"float"> checkpoint,
+                   args::Typed<"Optional[float]"> reduction_allowed, args::Typed<"bool"> reduction_check) {
     const args::CaseArg cs_arg(case_arg);
     const Case& cs = *cs_arg;
     const int n = args::rfes(n_arg);
@@ -299,6 +308,8 @@ PYBIND11_MODULE(_rfem, m) {
     RunRequest rq = python_request(pending, progress, threads, keep_series, checkpoint, warnings);
     rq.n = n;
     rq.runs = run_names(args::texts(runs, "runs"));
+    if (!reduction_allowed.is_none()) rq.reduction_allowed = py::cast<double>(reduction_allowed);
+    rq.reduction_error = args::flag(reduction_check, "reduction_check");
     std::vector<RunResult> results;
     {
       const std::string made_by = output.empty() ? "" : python_made_by("rfem.run");
@@ -312,7 +323,7 @@ PYBIND11_MODULE(_rfem, m) {
     py::object error = pending->take();
     return py::make_tuple(out, error, warnings);
   }, py::arg("case"), py::arg("n"), py::arg("output"), py::arg("runs"), py::arg("threads"), py::arg("keep_series"),
-     py::arg("progress"), py::arg("checkpoint"));
+     py::arg("progress"), py::arg("checkpoint"), py::arg("reduction_allowed") = py::none(), py::arg("reduction_check") = true);
 
   m.attr("CHECKPOINT_INTERVAL") = kCheckpointInterval;
 

@@ -53,6 +53,11 @@ struct RunResult {
   IntegratorStats stats;
   long samples = 0;                     ///< output steps delivered
   std::vector<LinkPeaks> peaks;         ///< per link (empty without links)
+  /// A run of reduced links: its peaks' estimated reduction error per link, signed (reduced − full
+  /// peaks, both run at n = reduction_n; studies/reduction_error.hpp). Empty with reduction_n = 0:
+  /// no estimate (no reduced link, not asked for, or the run did not complete).
+  std::vector<LinkPeaks> reduction_error;
+  int reduction_n = 0;
   /// max |balance(t) − balance(0)| with balance = T + V + dissipated − input work [J], and the
   /// largest of T, |V_e|, |input work| for scale.
   double energy_drift = 0, energy_scale = 0;

@@ -21,9 +21,10 @@ Reported reported_by_run(const Case& cs) {
     if (run == RunName::Rigid) continue;
     for (const LinkCase& l : cs.links) {
       const std::string series = to_string(run) + "/" + (cs.links.size() > 1 ? l.name + "/" : std::string());
-      r.add("peak:" + series + "u1", group);
-      r.add("peak:" + series + "u2", group++);
-      r.add("peak:" + series + "theta", group++);
+      const double length = l.link.total_length();
+      r.add("peak:" + series + "u1", group, kZeroPeak * length);
+      r.add("peak:" + series + "u2", group++, kZeroPeak * length);
+      r.add("peak:" + series + "theta", group++, kZeroPeak);
     }
   }
   return r;
@@ -118,6 +119,8 @@ AccuracyResult meet_accuracy(const Case& cs, const AccuracySpec& target, const R
   rq.quantities = reported.quantities;
   rq.groups = reported.groups;
   apply_target(cs, target, rq);
+  rq.zero_below = reported.zero_below;
+  rq.zero_below.resize(rq.quantities.size(), 0.0);  // (quantities named only by an absolute target)
   rq.integration_check = true;
   AccuracyResult out;
   out.target = target;
@@ -148,15 +151,15 @@ AccuracyResult meet_accuracy(const Case& cs, const AccuracySpec& target, const R
 void write_accuracy(const std::string& path, const AccuracyResult& a) {
   ResultsWriter file(path, Reopen{});
   Table t;
-  t.cols = 7;
+  t.cols = 8;
   std::vector<std::string> names;
   for (const Estimate& e : a.estimates) {
     names.push_back(e.quantity);
-    t.data.insert(t.data.end(), {e.value, e.error, e.error_space, e.error_time, e.observed_order, e.asymptotic ? 1.0 : 0.0, e.allowed});
+    t.data.insert(t.data.end(), {e.value, e.error, e.error_space, e.error_time, e.error_reduction, e.observed_order, e.asymptotic ? 1.0 : 0.0, e.allowed});
     ++t.rows;
   }
-  file.write_table("accuracy", t, {"value", "error", "error_space", "error_time", "observed_order", "asymptotic", "allowed"},
-                   {"", "", "", "", "1", "1", ""},
+  file.write_table("accuracy", t, {"value", "error", "error_space", "error_time", "error_reduction", "observed_order", "asymptotic", "allowed"},
+                   {"", "", "", "", "", "1", "1", ""},
                    "each reported value (attribute quantities, the row's) with its error bar at n (docs/accuracy.md); "
                    "NaN: no bar; allowed: the bar its target asked for (inf: none)");
   file.write_attribute("accuracy", "quantities", names);

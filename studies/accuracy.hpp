@@ -17,6 +17,9 @@ struct Estimate {
   std::string quantity;
   double value = NAN;
   double error = NAN, error_space = NAN, error_time = NAN;  ///< NaN: no bar
+  /// A run of reduced links: the reduction's estimated error (studies/reduction_error.hpp), in
+  /// `error` too; NaN: none.
+  double error_reduction = NAN;
   double observed_order = NAN;
   bool asymptotic = false;
   bool zero = false;          ///< zero at every n (the case's symmetry keeps it so): no bar needed
@@ -29,11 +32,18 @@ struct Estimate {
 struct Reported {
   std::vector<std::string> quantities;
   std::vector<int> groups;
-  void add(const std::string& q, int group) {
+  std::vector<double> zero_below;  ///< RefineRequest::zero_below
+  void add(const std::string& q, int group, double zero = 0.0) {
     quantities.push_back(q);
     groups.push_back(group);
+    zero_below.push_back(zero);
   }
 };
+
+/// A peak below this (of the link's length [m], or [rad]) is zero by the case's symmetry: round-off
+/// of a motion of order 1 is 1e-16…1e-11 (a reduced link's projection), a tenth of the smallest
+/// relative target (kMinRelativeTarget) is 1e-9.
+inline constexpr double kZeroPeak = 1e-9;
 
 /// `rfem run`: every flexible link's peak |u1|, |u2| (one scale) and |θ| in every run of the
 /// procedure that moves flexible links (not the paper's rigid run). CaseError for a case that cannot

@@ -27,6 +27,7 @@ std::vector<double> evaluate_dynamic(const Case& cs, const std::vector<JointInpu
   r.observers = rq.observers;
   r.observers.push_back(&values);
   r.warn = rq.warn;
+  r.reduction_error = false;  // (a ladder's points: meet_accuracy adds the estimate at its n)
   for (const std::string& name : runs_read(qs)) {
     RunName run;
     if (parse(name, run)) r.runs.push_back(run);
@@ -70,12 +71,12 @@ double group_scale(const RefineRequest& rq, const std::vector<std::vector<double
   return scale;
 }
 
-// Whether quantity k is zero at every n so far, to round-off of its group's scale (a deflection
-// the case's symmetry keeps at zero): it needs no bar.
+// Whether quantity k is zero at every n so far, to round-off of its group's scale or below its
+// zero_below (a deflection the case's symmetry keeps at zero): it needs no bar.
 bool identically_zero(const RefineRequest& rq, const std::vector<std::vector<double>>& values, size_t k) {
-  const double scale = group_scale(rq, values, k);
+  const double below = std::max(kZeroOfScale * group_scale(rq, values, k), k < rq.zero_below.size() ? rq.zero_below[k] : 0.0);
   for (double v : values[k])
-    if (std::abs(v) > 1e-12 * scale) return false;
+    if (std::abs(v) > below) return false;
   return true;
 }
 

@@ -21,6 +21,9 @@ namespace rfem {
 inline constexpr int kFirstTargetN = 8;
 inline constexpr int kMaxTargetN = 2048;
 
+/// Round-off of a group's scale: a quantity no larger at every n is zero (its case's symmetry).
+inline constexpr double kZeroOfScale = 1e-12;
+
 struct RefineRequest {
   std::vector<int> ns;                  ///< strictly increasing, at least two (one with `modes`)
   /// A series over modes instead of n (strictly increasing, each ≥ 1): rows m …, then 0 (the full model).
@@ -37,6 +40,10 @@ struct RefineRequest {
   std::vector<double> absolute;
   /// Quantities that share a scale for the relative target (one id per quantity; empty: each its own).
   std::vector<int> groups;
+  /// Per quantity, a magnitude below which it is zero by the case's symmetry (empty or 0: only
+  /// round-off of its group's scale, kZeroOfScale, is): a reduced link's round-off reaches 1e-11 of
+  /// a deflection, and a rotation that is its own group has no other scale.
+  std::vector<double> zero_below;
   int max_n = kMaxTargetN;
   /// Wall time a command with a target may take [s] (0: none): its ladder stops before an n whose
   /// predicted end would pass it (that n's cost from the last two levels' growth, at least linear,
@@ -73,7 +80,7 @@ struct RefineResult {
   /// its predicted end and max_time, when the wall-time limit did.
   std::string time_limit;
   std::vector<double> allowed;         ///< with a target: each quantity's bar must be ≤ this (inf: no target)
-  /// Per quantity: zero at every n, to 1e-12 of its group's scale (by the case's symmetry): no bar needed.
+  /// Per quantity: zero at every n, to kZeroOfScale of its group's scale or below its zero_below (by the case's symmetry): no bar needed.
   std::vector<bool> zero;
   double rtol = 0.0, atol = 0.0;       ///< the tolerances the runs used (dynamic quantities; chosen or the case's)
   /// With a relative target and dynamic quantities: how the tolerances were chosen, a line per try.

@@ -10,6 +10,7 @@
 #include "../simulation/recorders.hpp"
 #include "../simulation/sensors.hpp"
 #include "../simulation/state.hpp"
+#include "reduction_error.hpp"
 
 namespace rfem {
 
@@ -155,6 +156,7 @@ std::vector<RunResult> resume_case(const ResumePlan& plan, RunRequest rq) {
   Hdf5Recorder recorder(file);
   rq.observers.insert(rq.observers.begin(), &recorder);
   std::vector<RunResult> runs = run_case(cs, model, inputs, rq);
+  write_reduction_error(file, runs);  // (of the runs run now: with their whole runs' peaks)
   file.close();
   // Series and sensor rows kept in memory hold only what came after the checkpoint: the whole run is
   // in the file.

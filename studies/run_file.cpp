@@ -6,6 +6,7 @@
 #include "../simulation/inputs.hpp"
 #include "../simulation/recorders.hpp"
 #include "../simulation/simulation.hpp"
+#include "reduction_error.hpp"
 #include "resume.hpp"
 
 namespace rfem {
@@ -75,6 +76,7 @@ FileRuns run_into_file(const Case& cs, RunRequest rq, const std::string& output,
   Hdf5Recorder recorder(*file);
   rq.observers.insert(rq.observers.begin(), &recorder);
   out.runs = run_case(cs, out.model, inputs, rq);
+  write_reduction_error(*file, out.runs);
   file->close();
   // ParaView's view of every run that stored its poses (also of a failed run: what it computed).
   out.views = write_views(cs, *out.model, output, rq.warn);

@@ -12,6 +12,7 @@
 #include "../simulation/simulation.hpp"
 #include "../simulation/state.hpp"
 #include "../simulation/validity.hpp"
+#include "reduction_error.hpp"
 #include "run_file.hpp"
 
 namespace rfem {
@@ -71,6 +72,7 @@ std::vector<RunResult> run_case(const Case& cs, std::shared_ptr<const Model> mod
   } else if (wanted(RunName::Run)) {
     runs.push_back(run_one(rq.prefix + "run", model, inputs, cs, rq));
   }
+  estimate_reduction_error(cs, *model, rq, runs);
   return runs;
 }
 

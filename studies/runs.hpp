@@ -30,6 +30,11 @@ struct RunRequest : RunOptions {
   /// run again, and the checkpoints the others resume from.
   std::vector<std::string> done;
   std::map<std::string, Checkpoint> resume;
+  /// With reduced links: estimate each run's reduction error (studies/reduction_error.hpp) by full
+  /// and reduced runs at a coarse n after the runs complete, and warn through `warn` where it
+  /// exceeds `reduction_allowed` of a peak (the target's relative accuracy, else the defaults' aim).
+  bool reduction_error = true;
+  double reduction_allowed = kDefaultsAim;
 };
 
 /// Runs the case's procedure on its model with n rfes (CaseError for a case without

@@ -197,7 +197,7 @@ class Runs(list):
 
 def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, progress=None, resume=None,
         checkpoint=_rfem.CHECKPOINT_INTERVAL, controller=None, sample_time=None, delay=0, accuracy=None, max_n=None,
-        max_time=None):
+        max_time=None, reduction_check=True):
     """Runs the case's [simulation] by its procedure (single: "run"; paper: "rigid", "kinematic",
     "force") and returns the Runs.
 
@@ -223,6 +223,11 @@ def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, 
                  (absolute), or a list; rfem chooses the tolerances and n (up to max_n, default 2048;
                  max_time: seconds the ladder may take, it stops before an n predicted to end past it)
                  and the Runs carry .accuracy (rfem.Accuracy: each peak with its error bar; .met)
+
+    A case with reduced links (links.modes) runs its procedure again on the full and the reduced
+    model at a coarse n: each Run's .reduction_error is the estimate of its peaks' reduction error
+    (README, "Reduced links"), and a warning says where it exceeds the target (or 1e-4 of a peak);
+    reduction_check=False skips those runs (`rfem run --no-reduction-check`).
 
     A run that fails has status "failed: …" (the outputs before kept); Ctrl-C raises
     RunInterrupted with the runs so far in .result."""
@@ -252,13 +257,16 @@ def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, 
         case = (case if isinstance(case, Case) else load(case)).with_values({"simulation.rtol": acc.rtol,
                                                                               "simulation.atol": acc.atol})
         n = acc.n
-    out, error, warnings = _rfem._run(case, n, output, runs, threads, keep_series, progress, checkpoint)
+    out, error, warnings = _rfem._run(case, n, output, runs, threads, keep_series, progress, checkpoint,
+                                      acc.relative if acc is not None and acc.relative > 0 else None, reduction_check)
     result = Runs(out)
     result.warnings = warnings
     result.accuracy = acc
     _raise(error, result)
-    if acc is not None and output is not None and result.completed:
-        _rfem._write_accuracy(output, acc)
+    if acc is not None and result.completed:
+        _rfem._add_reduction_error(acc, out)
+        if output is not None:
+            _rfem._write_accuracy(output, acc)
     return result
 
 
