@@ -1,8 +1,8 @@
 """The extension rfem._rfem for `pip install --no-build-isolation .`, built by the project's own CMake.
 
 Metadata is in pyproject.toml; the version is CMakeLists.txt's project(rfem VERSION ...). The wheel
-holds every python/rfem/*.py, py.typed and the stubs (_rfem.pyi: scripts/make_stubs.py), the module
-_rfem as CMake built it, and librfem when it is a shared library, next to _rfem, which finds it
+holds every python/rfem/*.py, py.typed and the stubs (_rfem.pyi: scripts/make_stubs.py), the shipped
+cases (rfem/cases: cases/*.toml and their URDF files), the module _rfem as CMake built it, and librfem when it is a shared library, next to _rfem, which finds it
 through its RUNPATH, set to $ORIGIN (CMake's own ELF editing; no patchelf). Nothing is written into
 the source tree but build-python/ (gitignored), and nothing at all with RFEM_BUILD_DIR.
 
@@ -117,6 +117,9 @@ class CMakeBuild(build_ext):
         dest = Path(self.get_ext_fullpath(ext.name)).parent
         dest.mkdir(parents=True, exist_ok=True)
         shutil.copy2(module, dest / module.name)
+        # The shipped cases as CMake copied them beside the module (python/CMakeLists.txt): rfem.cases.
+        shutil.rmtree(dest / "cases", ignore_errors=True)
+        shutil.copytree(module.parent / "cases", dest / "cases")
 
         # librfem (if shared) beside _rfem, found through $ORIGIN wherever the package goes.
         for name, path in sorted(shared_libraries(module, build_dir).items()):

@@ -2,7 +2,7 @@
 # The package as a user installs it: `pip install --no-build-isolation` of the checkout (pyproject.toml,
 # setup.py) into a fresh virtual environment, taking the module and librfem from this build directory
 # (RFEM_BUILD_DIR, RFEM_NO_BUILD: seconds, nothing compiled); `import rfem` and a tiny run from
-# another directory with the environment's python; the checked-in stubs (python/rfem/_rfem.pyi) are
+# another directory with the environment's python, a shipped case by its name; the checked-in stubs (python/rfem/_rfem.pyi) are
 # what the installed module gives (scripts/make_stubs.py --check).
 #   bash tests/python_venv_test.sh BUILD_DIR
 set -euo pipefail
@@ -45,7 +45,11 @@ ldd = subprocess.run(["ldd", rfem._rfem.__file__], capture_output=True, text=Tru
 for line in ldd.splitlines():  # librfem (when shared) from beside _rfem
     if "librfem" in line:
         assert os.path.join(here, "") in line, f"_rfem loads {line.strip()}"
-runs = rfem.run(rfem.load(os.path.join(src, "cases", "kane_spinup.toml"), {"simulation.t_end": 2.0}), n=4)
+# The shipped cases by name, from the installed package (not the checkout: this is another folder).
+assert "kane_spinup" in rfem.cases and "paper_deployment" in rfem.cases, rfem.cases
+assert rfem.case_path("kane_spinup").startswith(here + os.sep) and os.path.isfile(os.path.join(here, "cases", "urdf", "three_link_arm.urdf"))
+assert rfem.load("urdf_arm").name == "urdf_arm"  # (its URDF file found beside it)
+runs = rfem.run(rfem.load("kane_spinup", {"simulation.t_end": 2.0}), n=4)
 u1 = runs["run"].column("tip_deflection", 0)
 assert runs.completed and all(math.isfinite(x) for x in u1), runs["run"].status
 assert 1e-3 < abs(u1).max() < 1.0, f"tip deflection {abs(u1).max()} m"  # the spin-up bends the 10 m beam by ~0.1 m

@@ -25,10 +25,38 @@ Units are SI; the results layout is README.md's "Results (HDF5)".
 import math as _math
 import json as _json
 import os as _os
+import re as _re
 
 from . import _rfem
 from ._rfem import (MAX_RFES, Accuracy, Case, CaseError, LinearModel, Model, ModesResult, ResultsError, Run, RunStatus, StaticResult, Sweep,
                     __version__, build)
+
+
+# The shipped cases (the checkout's cases/*.toml and their URDF files, in the package's cases/): a
+# case argument that names one ("kane_spinup") where no such file is finds it, wherever the package is.
+_CASES_DIR = _os.path.join(_os.path.dirname(_os.path.abspath(__file__)), "cases")
+cases = sorted(f[:-5] for f in _os.listdir(_CASES_DIR) if f.endswith(".toml")) if _os.path.isdir(_CASES_DIR) else []
+
+
+def case_path(name):
+    """The path of the shipped case `name` ("kane_spinup" or "kane_spinup.toml"; rfem.cases lists them)."""
+    base = name[:-5] if isinstance(name, str) and name.endswith(".toml") else name
+    if base not in cases:
+        raise CaseError(f"{name}: no shipped case of that name (rfem.cases: {', '.join(cases)})")
+    return _os.path.join(_CASES_DIR, base + ".toml")
+
+
+def _case(case):
+    """A case argument with a shipped case's name (no such file here, no folder in it) as its path."""
+    if isinstance(case, (str, _os.PathLike)) and not isinstance(case, Case):
+        text = _os.fspath(case)
+        # (a name: letters, digits, _ . -; anything else goes to the module's own checks of a path)
+        if isinstance(text, str) and _re.fullmatch(r"[A-Za-z0-9_.-]+", text) and not _os.path.exists(text):
+            base = text[:-5] if text.endswith(".toml") else text
+            if base in cases:
+                return case_path(base)
+            raise CaseError(f"{text}: cannot open case file, and no shipped case has that name (rfem.cases: {', '.join(cases)})")
+    return case
 
 
 # The compiled functions wrapped in Python ones: a pool pickles a function by its module and name,
@@ -56,7 +84,7 @@ _os.register_at_fork(after_in_child=_rfem._after_fork)
 for _f in (run_point, finished_point, write_index, write_xdmf):
     _f.__doc__ = getattr(_rfem, _f.__name__).__doc__.split("\n", 1)[-1].strip()
 
-__all__ = ["Accuracy", "Case", "CaseError", "Frame", "LinearModel", "linearize", "Model", "ModesResult", "ResultsError", "Run", "RunInterrupted", "RunStatus", "Runs",
+__all__ = ["Accuracy", "Case", "CaseError", "cases", "case_path", "Frame", "LinearModel", "linearize", "Model", "ModesResult", "ResultsError", "Run", "RunInterrupted", "RunStatus", "Runs",
            "StaticResult", "RefineResult", "Tree", "load", "model", "show", "run", "static", "modes", "refine", "plot",
            "write_xdmf", "animate", "toml_value", "__version__", "Sweep", "SweepResult", "load_sweep", "sweep", "run_point",
            "finished_point", "write_index"]
@@ -154,6 +182,7 @@ def _accuracy_texts(accuracy):
 def _target(case, command, accuracy, max_n, n, count=6, rate=None, joint=1, threads=0, progress=None, max_time=None,
             free=None):
     """The Accuracy a target asks for (accuracy=, or the case's [accuracy] without n), or None."""
+    case = _case(case)
     acc, error = _rfem._accuracy(case, command, _accuracy_texts(accuracy), max_n, max_time, n, count, rate, joint, threads,
                                  progress, free)
     _raise(error, acc)
@@ -161,14 +190,16 @@ def _target(case, command, accuracy, max_n, n, count=6, rate=None, joint=1, thre
 
 
 def load(path, values=None, overrides=()):
-    """Reads and checks a case file (TOML). `values`: {path: value} as in Case.with_values;
-    `overrides`: 'key.path=value' strings as given to `rfem --set`."""
-    case = Case.load(path, overrides)
+    """Reads and checks a case file (TOML), by its path or by the name of a shipped case
+    ("kane_spinup": rfem.cases). `values`: {path: value} as in Case.with_values; `overrides`:
+    'key.path=value' strings as given to `rfem --set`."""
+    case = Case.load(_case(path), overrides)
     return case.with_values(values) if values else case
 
 
 def model(case, n=None):
     """The case's Model with n rfes in all links (None: the case's own discretisation)."""
+    case = _case(case)
     return _rfem.model(case, n)
 
 
@@ -231,6 +262,7 @@ def run(case=None, n=None, output=None, runs=None, threads=0, keep_series=True, 
 
     A run that fails has status "failed: …" (the outputs before kept); Ctrl-C raises
     RunInterrupted with the runs so far in .result."""
+    case = _case(case)
     if resume is not None:
         if case is not None or n is not None or output is not None or runs is not None:
             raise ValueError("rfem.run(resume=...) takes no case, n, output or runs: the results file has them")
@@ -292,6 +324,7 @@ class Tree(list):
 def show(case, n=None):
     """What the case builds, to check against its drawing: every joint, link and payload with
     what it is mounted on and where, masses, rfes, coordinates and inputs. print(rfem.show(case))."""
+    case = _case(case)
     text, entries, urdf, frames = _rfem._show(case, n)
     tree = Tree(entries)
     tree.text, tree.urdf, tree.frames = text, urdf, frames
@@ -303,6 +336,7 @@ def static(case, n=None, rate=None, joint=1, accuracy=None, max_n=None, max_time
     [rad/s or m/s] of joint `joint`, from 1) under gravity and the case's tip loads. Returns a
     StaticResult (tips per link, energies, coordinates). accuracy= (as rfem.run's; `rfem static
     --accuracy`): n chosen for the tips' displacements and rotations; .accuracy has their bars."""
+    case = _case(case)
     acc = _target(case, "static", accuracy, max_n, n, rate=rate, joint=joint, max_time=max_time)
     result = _rfem._static(case, acc.n if acc is not None else n, rate, joint)
     result.accuracy = acc
@@ -316,6 +350,7 @@ def modes(case, n=None, count=6, free=(), rate=None, joint=1, output=None, accur
     shapes, exact references for one uniform segment); `output`: an HDF5 file with the
     frequencies and shapes (group modes, as `rfem modes -o`). accuracy= (as rfem.run's; `rfem
     modes --accuracy`): n chosen for the first `count` frequencies; .accuracy has their bars."""
+    case = _case(case)
     acc = _target(case, "modes", accuracy, max_n, n, count=count, rate=rate, joint=joint, max_time=max_time, free=free)
     result = _rfem._modes(case, acc.n if acc is not None else n, count, free, rate, joint, output)
     result.accuracy = acc
@@ -358,6 +393,7 @@ def refine(case, ns, quantities, output=None, integration_check=True, rate=None,
     passes max_n (2048) or, with max_time (seconds), is predicted to end past it (["time_limit"] says
     so); ["met"] says whether it was, ["shortfall"] why not and by how much.
     Ctrl-C raises RunInterrupted with the rows done in .result."""
+    case = _case(case)
     out, error = _rfem._refine(case, ns, quantities, output, integration_check, rate, joint, threads, progress, modes,
                                _accuracy_texts(accuracy), max_n, max_time)
     result = RefineResult(out)
@@ -457,6 +493,7 @@ def linearize(case, n=None, state=None, threads=1, equilibrium=True, output=None
     M, D, K, B as (row, column, value) tables; MATLAB's h5read, h5py, SciPy read it), as
     `rfem linearize -o`. accuracy= (as rfem.run's; `rfem linearize --accuracy`): n chosen for the six
     lowest frequencies of the model about rest; .accuracy has their bars."""
+    case = _case(case)
     if accuracy is not None and state is not None:
         raise CaseError("--accuracy: a saved state has its own n (give no --state, or no target)")
     acc = _target(case, "linearize", accuracy, max_n, n, max_time=max_time) if state is None else None

@@ -13,7 +13,7 @@ The library's simulation/simulation.hpp does the work; see README.md, "Control i
 
 import os as _os
 
-from . import _rfem
+from . import _case, _rfem
 from ._rfem import SimulationState
 
 __all__ = ["Simulation", "SimulationState", "run_controlled", "load_state"]
@@ -67,7 +67,7 @@ class Simulation:
 
     def __init__(self, case, n=None, output=None, state=None, threads=0, keep_series=True):
         # (the arguments are checked by the module: TypeError, ValueError naming them)
-        self._sim = _rfem._Simulation(case, n, threads, output, keep_series, _state(state), "rfem.Simulation (Python)")
+        self._sim = _rfem._Simulation(_case(case), n, threads, output, keep_series, _state(state), "rfem.Simulation (Python)")
 
     time = property(lambda self: self._sim.time, doc="where the simulation is [s]")
     t_end = property(lambda self: self._sim.t_end, doc="the case's simulation.t_end [s]: advance() goes no further")
@@ -138,7 +138,7 @@ def run_controlled(case, controller, sample_time, n=None, delay=0, output=None, 
     controller's outputs are in the results file's run/control. An exception in the controller ends
     the run "failed: controller: …" (rows kept); a return that is not a dict of finite numbers by
     known joints raises TypeError or ValueError (the run in .run); Ctrl-C raises RunInterrupted."""
-    run, error, bad = _rfem._run_controlled(case, n, threads, output, keep_series, _state(state),
+    run, error, bad = _rfem._run_controlled(_case(case), n, threads, output, keep_series, _state(state),
                                             "rfem.run_controlled (Python)", controller, sample_time, delay)
     if error is not None:
         _raise(error, run)

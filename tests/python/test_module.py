@@ -404,3 +404,19 @@ def test_every_integrator_and_linear_solver_give_the_paper_cases_answer():
             assert rel <= (1e-4 if integrator == "esdirk" else 1e-3), (integrator, solver, name, rel)
     with pytest.raises(rfem.CaseError, match=r'simulation\.linear_solver: must be "chain" or "cholmod" \(got "lu"\)'):
         base.with_values({"simulation.linear_solver": "lu"})
+
+
+def test_shipped_cases_load_by_name_from_any_folder(tmp_path, monkeypatch):
+    """rfem.cases lists the shipped cases (the checkout's cases/*.toml, in the package); a case
+    argument that names one where no such file is loads it, its URDF beside it; the same case as its
+    path; an unknown name is one CaseError line that lists them."""
+    monkeypatch.chdir(tmp_path)
+    assert {"kane_spinup", "paper_deployment", "urdf_arm"} <= set(rfem.cases)
+    by_name = rfem.load("kane_beam")
+    by_path = rfem.load(os.path.join(ROOT, "cases", "kane_beam.toml"))
+    assert by_name.name == by_path.name == "kane_beam"
+    f = rfem.modes("kane_beam", n=8, count=2).frequencies
+    assert list(f) == list(rfem.modes(by_path, n=8, count=2).frequencies)
+    assert rfem.load("urdf_arm.toml").name == "urdf_arm"
+    with pytest.raises(rfem.CaseError, match=r"^kane_spin: cannot open case file, and no shipped case has that name \(rfem.cases: kane_beam"):
+        rfem.load("kane_spin")
