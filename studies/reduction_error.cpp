@@ -142,7 +142,9 @@ void add_reduction_error(AccuracyResult& a, const std::vector<RunResult>& runs) 
     for (size_t l = 0; r.reduction_n > 0 && l < r.reduction_error.size(); ++l) {
       const LinkPeaks& e = r.reduction_error[l];
       const std::string series = r.name + "/" + (r.peaks.size() > 1 ? r.peaks[l].name + "/" : std::string());
-      for (const auto& [part, err] : {std::pair{"u1", e.u1}, std::pair{"u2", e.u2}, std::pair{"theta", e.theta}}) {
+      for (const auto& pe : {std::pair{"u1", e.u1}, std::pair{"u2", e.u2}, std::pair{"theta", e.theta}}) {
+        const std::string part = pe.first;  // (no structured binding: Clang 14 cannot capture one)
+        const double err = pe.second;
         auto it = std::find_if(a.estimates.begin(), a.estimates.end(),
                                [&](const Estimate& x) { return x.quantity == "peak:" + series + part; });
         if (it == a.estimates.end()) continue;
