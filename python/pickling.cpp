@@ -193,12 +193,23 @@ std::shared_ptr<Model> model_from_unchecked(const py::tuple& t) {
   return std::const_pointer_cast<Model>(m);
 }
 
+// Per link (name, u1, u2, theta): a run's peaks and its reduction error alike.
+static py::list peaks_state(const std::vector<LinkPeaks>& peaks) {
+  py::list out;
+  for (const LinkPeaks& p : peaks) out.append(py::make_tuple(p.name, p.u1, p.u2, p.theta));
+  return out;
+}
+static std::vector<LinkPeaks> peaks_from(py::handle list) {
+  std::vector<LinkPeaks> out;
+  for (py::handle p : list.cast<py::list>()) {
+    const auto pt = p.cast<py::tuple>();
+    out.push_back(LinkPeaks{pt[0].cast<std::string>(), pt[1].cast<double>(), pt[2].cast<double>(), pt[3].cast<double>()});
+  }
+  return out;
+}
+
 py::tuple run_state(const RunResult& r) {
   const IntegratorStats& s = r.stats;
-  py::list peaks;
-  for (const LinkPeaks& p : r.peaks) peaks.append(py::make_tuple(p.name, p.u1, p.u2, p.theta));
-  py::list reduction;
-  for (const LinkPeaks& p : r.reduction_error) reduction.append(py::make_tuple(p.name, p.u1, p.u2, p.theta));
   py::object model = py::none();
   {
     std::lock_guard<std::mutex> lock(registry_mutex);
@@ -207,8 +218,8 @@ py::tuple run_state(const RunResult& r) {
   return py::make_tuple(
       kRunVersion, r.name, r.status.to_string(), r.wall_s, r.t_reached,
       py::make_tuple(s.steps, s.residual_evals, s.factorizations, s.newton_iters, s.newton_fails, s.error_test_fails, s.last_step),
-      r.samples, peaks, r.energy_drift, r.energy_scale, r.warnings, model, series_state(r.series.get()),
-      py::make_tuple(r.sensors.rows, r.sensors.cols, numbers(r.sensors.data)), r.sensor_columns, r.sensor_units, reduction, r.reduction_n);
+      r.samples, peaks_state(r.peaks), r.energy_drift, r.energy_scale, r.warnings, model, series_state(r.series.get()),
+      py::make_tuple(r.sensors.rows, r.sensors.cols, numbers(r.sensors.data)), r.sensor_columns, r.sensor_units, peaks_state(r.reduction_error), r.reduction_n);
 }
 
 std::shared_ptr<RunResult> run_from(const py::tuple& t) {
@@ -247,10 +258,7 @@ std::shared_ptr<RunResult> run_from_unchecked(const py::tuple& t) {
   r->stats = IntegratorStats{s[0].cast<long>(), s[1].cast<long>(), s[2].cast<long>(), s[3].cast<long>(), s[4].cast<long>(),
                              s[5].cast<long>(), s[6].cast<double>()};
   r->samples = t[6].cast<long>();
-  for (py::handle p : t[7].cast<py::list>()) {
-    const auto pt = p.cast<py::tuple>();
-    r->peaks.push_back(LinkPeaks{pt[0].cast<std::string>(), pt[1].cast<double>(), pt[2].cast<double>(), pt[3].cast<double>()});
-  }
+  r->peaks = peaks_from(t[7]);
   r->energy_drift = t[8].cast<double>();
   r->energy_scale = t[9].cast<double>();
   r->warnings = t[10].cast<std::vector<std::string>>();
@@ -262,10 +270,7 @@ std::shared_ptr<RunResult> run_from_unchecked(const py::tuple& t) {
   r->sensors.data = numbers_from(sensors[2]);
   r->sensor_columns = t[14].cast<std::vector<std::string>>();
   r->sensor_units = t[15].cast<std::vector<std::string>>();
-  for (py::handle p : t[16].cast<py::list>()) {
-    const auto pt = p.cast<py::tuple>();
-    r->reduction_error.push_back(LinkPeaks{pt[0].cast<std::string>(), pt[1].cast<double>(), pt[2].cast<double>(), pt[3].cast<double>()});
-  }
+  r->reduction_error = peaks_from(t[16]);
   r->reduction_n = t[17].cast<int>();
   return r;
 }

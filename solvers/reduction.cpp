@@ -43,10 +43,12 @@ Reduction::Reduction(const Model& model, const VecX& qb, const Parallelism& para
   }
 }
 
+bool has_reduced_link(const Model& model) {
+  return std::any_of(model.links.begin(), model.links.end(), [](const MountedLink& l) { return l.d.modes > 0; });
+}
+
 std::shared_ptr<const Reduction> Reduction::of(const Model& model, const VecX& qb, const Parallelism& parallel) {
-  for (const MountedLink& L : model.links)
-    if (L.d.modes > 0) return std::make_shared<const Reduction>(model, qb, parallel);
-  return nullptr;
+  return has_reduced_link(model) ? std::make_shared<const Reduction>(model, qb, parallel) : nullptr;
 }
 
 SparseMat Reduction::projector(int k) const {

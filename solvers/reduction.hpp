@@ -33,6 +33,9 @@ namespace rfem {
 
 using SparseMat = Eigen::SparseMatrix<double>;
 
+/// Some link of the model keeps modes (d.modes > 0) instead of its rfes' rotations.
+bool has_reduced_link(const Model& model);
+
 class Reduction {
  public:
   struct Link {
@@ -53,7 +56,7 @@ class Reduction {
   /// threads `parallel` allows (the caller's choice holds here too). Throws std::invalid_argument
   /// naming the link for modes larger than 6n, or a cut through a pair of equal frequencies.
   Reduction(const Model& model, const VecX& qb, const Parallelism& parallel = {});
-  /// Null if no link of the model is reduced.
+  /// Null if no link of the model is reduced (has_reduced_link).
   static std::shared_ptr<const Reduction> of(const Model& model, const VecX& qb, const Parallelism& parallel = {});
 
   int full_rfe() const { return full_rfe_; }  ///< 6n

@@ -13,10 +13,6 @@
 
 namespace rfem {
 
-bool has_reduced_link(const Model& model) {
-  return std::any_of(model.links.begin(), model.links.end(), [](const MountedLink& l) { return l.d.modes > 0; });
-}
-
 int companion_n(const Case& cs, const Model& model) {
   const int n = model.n();
   // Enough rotations beside the m kept that the modes left out, whose effect is the error, are there.
@@ -67,8 +63,7 @@ void estimate_reduction_error(const Case& cs, const Model& model, const RunReque
   c.checkpoint_interval = 0.0;
   c.reduction_error = false;
   c.runs = which;
-  std::vector<std::string> ignored;  // (the companions' own validity warnings are the run's)
-  c.warn = [&ignored](const std::string& w) { ignored.push_back(w); };
+  c.warn = [](const std::string&) {};  // (the companions' own validity warnings are the run's)
   // A companion that fails leaves the runs as they are, without an estimate, and says why.
   auto companion = [&](const Case& which_case, const char* what) -> std::optional<std::vector<RunResult>> {
     c.prefix = rq.prefix + "reduction check, " + what + ", n = " + std::to_string(nc) + "/";

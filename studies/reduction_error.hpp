@@ -8,15 +8,13 @@
 #include <vector>
 
 #include "../core/model.hpp"
+#include "../solvers/reduction.hpp"
 #include "accuracy.hpp"
 #include "runs.hpp"
 
 namespace rfem {
 
 class ResultsWriter;
-
-/// The model has a reduced link (a link with modes > 0).
-bool has_reduced_link(const Model& model);
 
 /// The coarse n of the companion runs for a model of n rfes: n / kCompanionShare, raised until
 /// every reduced link has at least kCompanionModes × its modes of rotations to choose from (3 per
